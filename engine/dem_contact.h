@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: MIT
+/// @file dem_contact.h
+/// The linear spring–dashpot (LSD) contact law of Tiscar et al. (2019),
+/// section 2.1, as one stateless kernel shared by granule–granule and
+/// granule–wall contacts (a wall is a granule of infinite mass and radius:
+/// the caller passes m* = m_i and R* = R_i, and nothing here branches on it).
+///
+/// The kernel is `static inline` and takes a feature mask that is a
+/// compile-time constant at every call site in the force loops, so the
+/// compiler removes every effect a scene does not use (see dem_features).
+#ifndef DEM_CONTACT_H
+#define DEM_CONTACT_H
+
+#include "dem_vec.h"
+
+/// Effects a scene can switch on. Unused effects cost nothing: the force
+/// loop is instantiated once per mask, and history slots exist only for the
+/// springs that are on.
+enum dem_feature {
+    DEM_FEAT_DAMPING = 1u << 0,    ///< normal dashpot, eq. 3–4
+    DEM_FEAT_TANGENTIAL = 1u << 1, ///< tangential spring with history, eq. 6–8
+    DEM_FEAT_ROLLING = 1u << 2,    ///< rolling quasi-force spring, eq. 11–13
+    DEM_FEAT_PERIODIC = 1u << 3,   ///< one periodic axis (loop level, not kernel)
+    DEM_FEAT_COUNT_MASKS = 1u << 4
+};
+
+/// Which sign of the normal relative velocity switches the dashpot of eq. 4
+/// on. The equation, read literally with the sign conventions of eq. 3 and 5
+/// (n_ij points from i to j, v_rel,n·n_ij > 0 while approaching), damps only
+/// while the granules separate. At ξ = 0.7 the four readings give very
+/// different restitution coefficients (see README, tests/unit/test_contact.c).
+typedef enum dem_damping_mode {
+    /// Damped only while approaching: the dashpot never pulls granules
+    /// together, consistent with the paper's "adhesive forces are not
+    /// considered". Default. e = 0.459 at ξ = 0.7.
+    DEM_DAMPING_APPROACHING = 0,
+    /// Damped in both phases (the classic damped oscillator). e = 0.046.
+    DEM_DAMPING_ALWAYS = 1,
+    /// Damped only while separating: eq. 4 read literally. e = 0.100.
+    DEM_DAMPING_SEPARATING = 2,
+    /// Damped in both phases, total normal force clamped at zero (never
+    /// attractive). e = 0.210.
+    DEM_DAMPING_NO_TENSION = 3,
+    DEM_DAMPING_MODE_COUNT = 4
+} dem_damping_mode;
+
+/// Parameters of one contact kind (granule–granule, or granule–one wall
+/// material), in SI units. Table 3 gives the paper's calibrated values.
+typedef struct dem_contact_params {
+    double k_n;  ///< normal stiffness, N/m (eq. 3)
+    double k_s;  ///< tangential stiffness, N/m (eq. 6)
+    double k_r;  ///< rolling stiffness, N/m (eq. 11)
+    double xi;   ///< damping ratio ξ (eq. 4)
+    double mu_s; ///< sliding friction coefficient (eq. 8)
+    double mu_r; ///< rolling friction coefficient (eq. 13)
+    dem_damping_mode damping;
+} dem_contact_params;
+
+/// Coefficients the kernel needs, derived once from dem_contact_params so the
+/// inner loop has no mode switch: the damping reading becomes two 0/1 factors
+/// and a 0/1 clamp.
+typedef struct dem_contact_coeffs {
+    double k_n, k_s, k_r, mu_s, mu_r;
+    double inv_k_s, inv_k_r;  ///< 0 where the stiffness is 0
+    double two_xi_sqrt_kn;    ///< γ_n = two_xi_sqrt_kn·sqrt(m*) (eq. 4)
+    double damp_approaching;  ///< 1 if the dashpot acts while approaching
+    double damp_separating;   ///< 1 if the dashpot acts while separating
+    double clamp_tension;     ///< 1 to clamp the normal force at zero
+} dem_contact_coeffs;
+
+/// Geometry and kinematics of one contact at the current step.
+typedef struct dem_contact_state {
+    dem_vec3 normal;       ///< n_ij, unit, pointing from i to j
+    double overlap;        ///< h_ij = R_i + R_j − |r_j − r_i| > 0
+    dem_vec3 vrel;         ///< velocity of i's contact point minus j's (eq. 5, 7)
+    dem_vec3 wrel;         ///< ω_i − ω_j (eq. 12); for a wall ω_j is the wall's spin
+    double twist;          ///< angle the pair turned about n this step, ½(ω_i+ω_j)·n Δt
+    double reduced_mass;   ///< m* (m_i for a wall)
+    double reduced_radius; ///< R* (R_i for a wall)
+    double dt;
+} dem_contact_state;
+
+/// What a contact does to granule i (j receives the opposite force, and the
+/// torques of eq. 9–10, which the caller forms from these).
+typedef struct dem_contact_out {
+    dem_vec3 force;        ///< F_ij,n + F_ij,s on i
+    dem_vec3 f_tangential; ///< F_ij,s on i
+    dem_vec3 f_rolling;    ///< rolling quasi-force F_ij,r
+    double normal_force;   ///< signed magnitude along −n_ij (> 0 repulsive)
+} dem_contact_out;
+
+/// Doubles of history a contact needs for the given feature mask.
+static inline int dem_history_len(unsigned features)
+{
+    return 3 * (((features & DEM_FEAT_TANGENTIAL) != 0) + ((features & DEM_FEAT_ROLLING) != 0));
+}
+
+/// Derive kernel coefficients from parameters.
+dem_contact_coeffs dem_contact_coeffs_make(const dem_contact_params *p);
+
+/// Features a parameter set actually uses (a friction of zero switches the
+/// spring off: it could never carry force).
+unsigned dem_contact_features(const dem_contact_params *p);
+
+/// Name of a damping reading ("approaching", "always", "separating",
+/// "no_tension"), and its inverse; returns -1 for an unknown name.
+const char *dem_damping_mode_name(dem_damping_mode mode);
+int dem_damping_mode_from_name(const char *name);
+
+/// Check a parameter set; on error writes a message naming the field and
+/// returns non-zero.
+int dem_contact_params_check(const dem_contact_params *p, char *msg, unsigned long msg_len);
+
+/// Carry a history spring onto the contact's current tangent plane: turn it
+/// with the pair about n (twist), project it onto the plane normal to n, and
+/// rescale it to its old length (Luding 2008), so rigid motion of the pair
+/// neither creates nor destroys spring length.
+static inline dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twist)
+{
+    double len2 = dem_v3_norm2(spring);
+    if (len2 == 0.0) return spring;
+    dem_vec3 turned = dem_v3_axpy(twist, dem_v3_cross(n, spring), spring);
+    dem_vec3 proj = dem_v3_axpy(-dem_v3_dot(turned, n), n, turned);
+    double plen2 = dem_v3_norm2(proj);
+    double scale = plen2 > 0.0 ? sqrt(len2 / plen2) : 0.0;
+    return dem_v3_scale(proj, scale);
+}
+
+/// Advance one history spring by its relative velocity and apply the Coulomb
+/// limit: F = −k·δ, |F| ≤ μ|F_n|; on truncation the spring is reset so that
+/// k|δ| equals the limit (eq. 6+8 for sliding, eq. 11+13 for rolling).
+static inline dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist, dem_vec3 vel, double dt,
+                                         double k, double inv_k, double limit)
+{
+    dem_vec3 spring = dem_spring_carry(dem_v3(hist[0], hist[1], hist[2]), n, twist);
+    spring = dem_v3_axpy(dt, vel, spring);
+    dem_vec3 force = dem_v3_scale(spring, -k);
+    double f2 = dem_v3_norm2(force);
+    if (f2 > limit * limit) {
+        force = dem_v3_scale(force, limit / sqrt(f2));
+        spring = dem_v3_scale(force, -inv_k);
+    }
+    hist[0] = spring.x;
+    hist[1] = spring.y;
+    hist[2] = spring.z;
+    return force;
+}
+
+/// The LSD contact law, eq. 3–8 and 11–13. `features` must be a constant at
+/// the call site. `hist` holds dem_history_len(features) doubles: tangential
+/// spring δ_s first (if on), then rolling spring δ_r (if on); zero for a new
+/// contact. Springs store displacements; forces are −k·δ.
+static inline void dem_contact_eval(const dem_contact_coeffs *c, const dem_contact_state *s, double *hist,
+                                    dem_contact_out *out, const unsigned features)
+{
+    const dem_vec3 n = s->normal;
+    const double vn = dem_v3_dot(s->vrel, n); // > 0 approaching (eq. 5)
+    // Eq. 3: F_n = −k_n h n − γ_n v_rel,n; here fn is its magnitude along −n.
+    double fn = c->k_n * s->overlap;
+    if (features & DEM_FEAT_DAMPING) {
+        // Eq. 4: γ_n = 2ξ sqrt(m* k_n), on for the phase(s) the reading selects.
+        double on = vn > 0.0 ? c->damp_approaching : c->damp_separating;
+        fn += on * c->two_xi_sqrt_kn * sqrt(s->reduced_mass) * vn;
+        fn = c->clamp_tension != 0.0 && fn < 0.0 ? 0.0 : fn;
+    }
+    out->normal_force = fn;
+    out->force = dem_v3_scale(n, -fn);
+    const double fn_abs = fabs(fn);
+    int slot = 0;
+    if (features & DEM_FEAT_TANGENTIAL) {
+        // Eq. 7: tangential part of the contact-point relative velocity.
+        dem_vec3 vt = dem_v3_axpy(-vn, n, s->vrel);
+        out->f_tangential = dem_spring_update(hist, n, s->twist, vt, s->dt, c->k_s, c->inv_k_s, c->mu_s * fn_abs);
+        out->force = dem_v3_add(out->force, out->f_tangential);
+        slot += 3;
+    } else {
+        out->f_tangential = dem_v3(0, 0, 0);
+    }
+    if (features & DEM_FEAT_ROLLING) {
+        // Eq. 12: v_rel,r = −R* (ω_i − ω_j) × n.
+        dem_vec3 vr = dem_v3_scale(dem_v3_cross(s->wrel, n), -s->reduced_radius);
+        out->f_rolling = dem_spring_update(hist + slot, n, s->twist, vr, s->dt, c->k_r, c->inv_k_r, c->mu_r * fn_abs);
+    } else {
+        out->f_rolling = dem_v3(0, 0, 0);
+    }
+}
+
+#endif

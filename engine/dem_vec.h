@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: MIT
+/// @file dem_vec.h
+/// Small 3-vector arithmetic used by every kernel. All inline: the contact
+/// kernels are specialised by the compiler, so these must fold away.
+#ifndef DEM_VEC_H
+#define DEM_VEC_H
+
+#include <math.h>
+
+/// π (DEM_PI is not in strict C11).
+#define DEM_PI 3.14159265358979323846
+
+/// A 3-vector of doubles; plain struct so arrays of it are dense (24 bytes).
+typedef struct dem_vec3 {
+    double x, y, z;
+} dem_vec3;
+
+static inline dem_vec3 dem_v3(double x, double y, double z) { return (dem_vec3){x, y, z}; }
+static inline dem_vec3 dem_v3_add(dem_vec3 a, dem_vec3 b) { return dem_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline dem_vec3 dem_v3_sub(dem_vec3 a, dem_vec3 b) { return dem_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline dem_vec3 dem_v3_scale(dem_vec3 a, double s) { return dem_v3(a.x * s, a.y * s, a.z * s); }
+static inline dem_vec3 dem_v3_axpy(double s, dem_vec3 a, dem_vec3 b) { return dem_v3(s * a.x + b.x, s * a.y + b.y, s * a.z + b.z); }
+static inline double dem_v3_dot(dem_vec3 a, dem_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline double dem_v3_norm2(dem_vec3 a) { return dem_v3_dot(a, a); }
+static inline double dem_v3_norm(dem_vec3 a) { return sqrt(dem_v3_dot(a, a)); }
+static inline dem_vec3 dem_v3_cross(dem_vec3 a, dem_vec3 b)
+{
+    return dem_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline dem_vec3 dem_v3_neg(dem_vec3 a) { return dem_v3(-a.x, -a.y, -a.z); }
+static inline int dem_v3_isfinite(dem_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+#endif

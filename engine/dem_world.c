@@ -1,0 +1,466 @@
+// SPDX-License-Identifier: MIT
+// World lifetime, granules and walls, velocity-Verlet stepping and faults.
+#include <float.h>
+#include <omp.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_stability.h"
+#include "dem_world_internal.h"
+
+dem_world_def dem_default_world_def(void)
+{
+    dem_world_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity = dem_v3(0.0, -9.81, 0.0);
+    // Table 3, granule–granule.
+    d.granule = (dem_contact_params){.k_n = 200, .k_s = 200, .k_r = 200, .xi = 0.7, .mu_s = 0.8, .mu_r = 0.2,
+                                     .damping = DEM_DAMPING_APPROACHING};
+    d.dt = 0.0;
+    d.dt_safety = 0.9;
+    d.domain_lo = dem_v3(-0.5, -0.5, -0.5);
+    d.domain_hi = dem_v3(0.5, 0.5, 0.5);
+    d.periodic_axis = -1;
+    d.skin = 0.0;
+    d.lever_arm = DEM_LEVER_CONTACT_POINT;
+    d.threads = 0;
+    return d;
+}
+
+int dem_world_set_error(dem_world *w, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(w->err, sizeof w->err, fmt, ap);
+    va_end(ap);
+    return 1;
+}
+
+static double axis_comp(dem_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
+
+static int check_def(const dem_world_def *d, char *msg, size_t len)
+{
+    char sub[256];
+    if (dem_contact_params_check(&d->granule, sub, sizeof sub)) {
+        snprintf(msg, len, "granule–granule contact: %s", sub);
+        return 1;
+    }
+    if (!(d->dt >= 0) || !isfinite(d->dt)) return snprintf(msg, len, "dt = %g: must be >= 0", d->dt), 1;
+    if (!(d->dt_safety > 0 && d->dt_safety <= 1))
+        return snprintf(msg, len, "dt_safety = %g: must be in (0, 1]", d->dt_safety), 1;
+    if (!(d->skin >= 0)) return snprintf(msg, len, "skin = %g: must be >= 0", d->skin), 1;
+    if (d->periodic_axis < -1 || d->periodic_axis > 2)
+        return snprintf(msg, len, "periodic_axis = %d: must be -1, 0, 1 or 2", d->periodic_axis), 1;
+    for (int a = 0; a < 3; ++a)
+        if (!(axis_comp(d->domain_hi, a) > axis_comp(d->domain_lo, a)))
+            return snprintf(msg, len, "domain: hi must exceed lo on axis %d", a), 1;
+    return 0;
+}
+
+static void refresh_features(dem_world *w)
+{
+    w->gg = dem_contact_coeffs_make(&w->def.granule);
+    w->features = dem_contact_features(&w->def.granule) | (w->def.periodic_axis >= 0 ? DEM_FEAT_PERIODIC : 0u);
+}
+
+dem_world *dem_world_create(const dem_world_def *def, char *err, size_t err_len)
+{
+    char msg[512];
+    if (check_def(def, msg, sizeof msg)) {
+        if (err) snprintf(err, err_len, "%s", msg);
+        return NULL;
+    }
+    dem_world *w = calloc(1, sizeof *w);
+    if (!w) {
+        if (err) snprintf(err, err_len, "out of memory");
+        return NULL;
+    }
+    w->def = *def;
+    w->lever_factor = def->lever_arm == DEM_LEVER_RADIUS ? 0.0 : 1.0;
+    refresh_features(w);
+    if (def->threads > 0) omp_set_num_threads(def->threads);
+    return w;
+}
+
+void dem_world_destroy(dem_world *w)
+{
+    if (!w) return;
+    void *arrays[] = {w->pos, w->vel, w->omg, w->frc, w->trq, w->rad, w->mass, w->inertia, w->inv_mass,
+                      w->inv_inertia, w->id, w->pair_f, w->pair_ti, w->pair_tj, w->rev_start, w->rev_pair,
+                      w->pos_at_build};
+    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) free(arrays[k]);
+    for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist);
+    dem_nl_free(&w->nl);
+    dem_nl_free(&w->nl_old);
+    free(w);
+}
+
+#define GROW(ptr, cap) ((ptr) = realloc_or_keep((ptr), (cap) * sizeof *(ptr), &fail))
+static void *realloc_or_keep(void *p, size_t bytes, int *fail)
+{
+    void *q = realloc(p, bytes);
+    if (!q) *fail = 1;
+    return q ? q : p;
+}
+
+static int grow_granules(dem_world *w, size_t need)
+{
+    if (need <= w->cap) return 0;
+    size_t cap = need < 64 ? 64 : need + need / 2;
+    int fail = 0;
+    GROW(w->pos, cap), GROW(w->vel, cap), GROW(w->omg, cap), GROW(w->frc, cap), GROW(w->trq, cap);
+    GROW(w->rad, cap), GROW(w->mass, cap), GROW(w->inertia, cap), GROW(w->inv_mass, cap);
+    GROW(w->inv_inertia, cap), GROW(w->id, cap), GROW(w->pos_at_build, cap);
+    for (int k = 0; k < w->n_walls; ++k) {
+        size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
+        GROW(w->walls[k].hist, cap * hl);
+    }
+    if (fail) return dem_world_set_error(w, "out of memory growing to %zu granules", cap);
+    w->cap = cap;
+    return 0;
+}
+
+static void invalidate(dem_world *w)
+{
+    w->list_valid = 0;
+    w->forces_valid = 0;
+}
+
+int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity, dem_vec3 omega, double radius,
+                              double density)
+{
+    if (!(radius > 0) || !isfinite(radius) || !(density > 0) || !isfinite(density)) {
+        dem_world_set_error(w, "granule radius %g m and density %g kg/m3 must be positive and finite", radius,
+                            density);
+        return -1;
+    }
+    if (!dem_v3_isfinite(position) || !dem_v3_isfinite(velocity) || !dem_v3_isfinite(omega)) {
+        dem_world_set_error(w, "granule position, velocity and spin must be finite");
+        return -1;
+    }
+    if (w->n >= UINT32_MAX || grow_granules(w, w->n + 1)) return -1;
+    size_t i = w->n++;
+    double m = density * 4.0 / 3.0 * DEM_PI * radius * radius * radius;
+    double inertia = 0.4 * m * radius * radius; // solid sphere
+    w->pos[i] = position;
+    w->vel[i] = velocity;
+    w->omg[i] = omega;
+    w->frc[i] = w->trq[i] = dem_v3(0, 0, 0);
+    w->rad[i] = radius;
+    w->mass[i] = m;
+    w->inertia[i] = inertia;
+    w->inv_mass[i] = 1.0 / m;
+    w->inv_inertia[i] = 1.0 / inertia;
+    w->id[i] = w->next_id++;
+    for (int k = 0; k < w->n_walls; ++k)
+        memset(w->walls[k].hist + i * w->walls[k].hist_len, 0, w->walls[k].hist_len * sizeof(double));
+    invalidate(w);
+    w->prepared = 0;
+    return (int64_t)w->id[i];
+}
+
+static int wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_params *p)
+{
+    char sub[256];
+    if (dem_contact_params_check(p, sub, sizeof sub))
+        return dem_world_set_error(w, "wall '%s' contact: %s", wall->name, sub);
+    wall->def.contact = *p;
+    wall->coeffs = dem_contact_coeffs_make(p);
+    wall->features = dem_contact_features(p);
+    int hl = dem_history_len(wall->features);
+    if (hl != wall->hist_len || !wall->hist) {
+        size_t cap = w->cap ? w->cap : 1;
+        double *h = realloc(wall->hist, cap * (size_t)(hl ? hl : 1) * sizeof *h);
+        if (!h) return dem_world_set_error(w, "out of memory for wall history");
+        wall->hist = h;
+        wall->hist_len = hl;
+        memset(h, 0, cap * (size_t)(hl ? hl : 1) * sizeof *h);
+    }
+    w->forces_valid = 0;
+    return 0;
+}
+
+static int check_wall_geometry(dem_world *w, const dem_wall_def *d)
+{
+    double axis_len = dem_v3_norm(d->axis), normal_len = dem_v3_norm(d->normal);
+    if ((unsigned)d->kind > DEM_WALL_CYLINDER) return dem_world_set_error(w, "wall kind %d unknown", (int)d->kind);
+    if (d->kind != DEM_WALL_CYLINDER && fabs(normal_len - 1.0) > 1e-9)
+        return dem_world_set_error(w, "wall '%s': normal must be a unit vector", d->name ? d->name : "");
+    if ((d->kind == DEM_WALL_CYLINDER || d->spin != 0.0) && fabs(axis_len - 1.0) > 1e-9)
+        return dem_world_set_error(w, "wall '%s': axis must be a unit vector", d->name ? d->name : "");
+    if (d->kind != DEM_WALL_PLANE && !(d->radius > 0))
+        return dem_world_set_error(w, "wall '%s': radius must be positive", d->name ? d->name : "");
+    if (!isfinite(d->spin)) return dem_world_set_error(w, "wall '%s': spin must be finite", d->name ? d->name : "");
+    return 0;
+}
+
+int dem_world_add_wall(dem_world *w, const dem_wall_def *def)
+{
+    if (w->n_walls >= DEM_MAX_WALLS) return dem_world_set_error(w, "at most %d walls", DEM_MAX_WALLS), -1;
+    if (check_wall_geometry(w, def)) return -1;
+    dem_wall *wall = &w->walls[w->n_walls];
+    memset(wall, 0, sizeof *wall);
+    wall->def = *def;
+    snprintf(wall->name, sizeof wall->name, "%s", def->name ? def->name : "wall");
+    wall->def.name = wall->name;
+    if (wall_set_contact(w, wall, &def->contact)) return -1;
+    w->prepared = 0;
+    return w->n_walls++;
+}
+
+void dem_world_set_wall_spin(dem_world *w, int wall, double spin)
+{
+    if (wall >= 0 && wall < w->n_walls) w->walls[wall].def.spin = spin;
+    w->forces_valid = 0;
+}
+
+int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)
+{
+    char sub[256];
+    if (dem_contact_params_check(p, sub, sizeof sub))
+        return dem_world_set_error(w, "granule–granule contact: %s", sub);
+    unsigned old = w->features;
+    w->def.granule = *p;
+    refresh_features(w);
+    if (dem_history_len(old) != dem_history_len(w->features)) w->list_valid = 0; // history layout changed
+    w->forces_valid = 0;
+    w->prepared = 0;
+    return 0;
+}
+
+int dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p)
+{
+    if (wall < 0 || wall >= w->n_walls) return dem_world_set_error(w, "no wall %d", wall);
+    w->prepared = 0;
+    return wall_set_contact(w, &w->walls[wall], p);
+}
+
+double dem_world_min_mass(const dem_world *w)
+{
+    double m = DBL_MAX;
+    for (size_t i = 0; i < w->n; ++i) m = w->mass[i] < m ? w->mass[i] : m;
+    return w->n ? m : 0.0;
+}
+
+double dem_world_min_radius(const dem_world *w)
+{
+    double r = DBL_MAX;
+    for (size_t i = 0; i < w->n; ++i) r = w->rad[i] < r ? w->rad[i] : r;
+    return w->n ? r : 0.0;
+}
+
+double dem_world_max_radius(const dem_world *w)
+{
+    double r = 0.0;
+    for (size_t i = 0; i < w->n; ++i) r = w->rad[i] > r ? w->rad[i] : r;
+    return r;
+}
+
+static int check_periodic_length(dem_world *w)
+{
+    int a = w->def.periodic_axis;
+    if (a < 0) return 0;
+    double len = axis_comp(w->def.domain_hi, a) - axis_comp(w->def.domain_lo, a);
+    // A pair must touch through one image only.
+    double need = 2.0 * (2.0 * dem_world_max_radius(w) + w->skin);
+    if (len <= need)
+        return dem_world_set_error(w,
+                                   "periodic length %g m along axis %d is too short: it must exceed %g m "
+                                   "(twice the largest diameter plus skin)",
+                                   len, a, need);
+    return 0;
+}
+
+dem_status dem_world_prepare(dem_world *w)
+{
+    if (w->prepared) return DEM_OK;
+    // Skin: a fraction of the smallest radius keeps rebuilds rare while the
+    // list stays short for the small granules of a wide GSD.
+    w->skin = w->def.skin > 0 ? w->def.skin : 0.4 * dem_world_min_radius(w);
+    if (check_periodic_length(w)) return DEM_ERR_INVALID;
+    if (w->n == 0) {
+        w->dt = w->def.dt > 0 ? w->def.dt : 1e-6;
+        snprintf(w->dt_report, sizeof w->dt_report, "no granules: dt = %g s", w->dt);
+        w->prepared = 1;
+        return DEM_OK;
+    }
+    dem_stability st = dem_stability_apriori(w);
+    if (w->def.dt > 0 && w->def.dt > st.dt_limit) {
+        dem_world_set_error(w,
+                            "time step %g s (%.3f of dt_crit = sqrt(m_min/k_n) = %g s, eq. 14) is above the "
+                            "stability limit %g s (%.3f of dt_crit): %s. Use a step <= %g s or leave dt unset.",
+                            w->def.dt, w->def.dt / st.dt_crit, st.dt_crit, st.dt_limit, st.dt_limit / st.dt_crit,
+                            st.why, st.dt_limit);
+        return DEM_ERR_UNSTABLE;
+    }
+    w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * st.dt_limit;
+    snprintf(w->dt_report, sizeof w->dt_report,
+             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = sqrt(m_min/k_n) = %.4g s; the paper uses 0.6); "
+             "%s: stability limit %.4g s = %.3f dt_crit%s",
+             w->dt, w->dt / st.dt_crit, st.dt_crit, st.why, st.dt_limit, st.dt_limit / st.dt_crit,
+             w->def.dt > 0 ? " (step as configured)" : "; step chosen at dt_safety of it");
+    w->prepared = 1;
+    w->forces_valid = 0;
+    return DEM_OK;
+}
+
+// Half kick and drift in one pass; flags granules that left the domain.
+static size_t kick_drift(dem_world *restrict w, int *escaped)
+{
+    const double h = 0.5 * w->dt, dt = w->dt;
+    const dem_vec3 g = w->def.gravity, lo = w->def.domain_lo, hi = w->def.domain_hi;
+    const int pa = w->def.periodic_axis;
+    size_t first_bad = SIZE_MAX;
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+    for (size_t i = 0; i < w->n; ++i) {
+        dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
+        w->vel[i] = v;
+        w->omg[i] = dem_v3_axpy(h * w->inv_inertia[i], w->trq[i], w->omg[i]);
+        dem_vec3 p = dem_v3_axpy(dt, v, w->pos[i]);
+        double *pc[3] = {&p.x, &p.y, &p.z};
+        if (pa >= 0) { // wrap into [lo, hi) along the periodic axis
+            double l = axis_comp(lo, pa), len = axis_comp(hi, pa) - l;
+            *pc[pa] -= len * floor((*pc[pa] - l) / len);
+        }
+        w->pos[i] = p;
+        int out = !(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z);
+        if (out && i < first_bad) first_bad = i;
+    }
+    *escaped = first_bad != SIZE_MAX;
+    return first_bad;
+}
+
+// Second half kick; returns the first granule whose state is not finite.
+static size_t kick(dem_world *restrict w)
+{
+    const double h = 0.5 * w->dt;
+    const dem_vec3 g = w->def.gravity;
+    size_t first_bad = SIZE_MAX;
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+    for (size_t i = 0; i < w->n; ++i) {
+        dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
+        dem_vec3 o = dem_v3_axpy(h * w->inv_inertia[i], w->trq[i], w->omg[i]);
+        w->vel[i] = v;
+        w->omg[i] = o;
+        // One test of a sum catches NaN or infinity in any component.
+        if (!isfinite(v.x + v.y + v.z + o.x + o.y + o.z + w->pos[i].x + w->pos[i].y + w->pos[i].z) &&
+            i < first_bad)
+            first_bad = i;
+    }
+    return first_bad;
+}
+
+static int refresh_list(dem_world *w)
+{
+    double half_skin = 0.5 * w->skin;
+    if (w->list_valid && dem_nl_max_displacement2(w) <= half_skin * half_skin) return 0;
+    return dem_nl_rebuild(w);
+}
+
+static dem_status fault(dem_world *w, dem_status code, size_t i, const char *what)
+{
+    dem_vec3 p = w->pos[i], v = w->vel[i];
+    dem_world_set_error(w,
+                        "%s: granule id %llu at step %llu (t = %.6g s), position (%g, %g, %g) m, velocity "
+                        "(%g, %g, %g) m/s, radius %g m",
+                        what, (unsigned long long)w->id[i], (unsigned long long)w->step, w->time, p.x, p.y, p.z,
+                        v.x, v.y, v.z, w->rad[i]);
+    return code;
+}
+
+dem_status dem_world_step(dem_world *w, uint64_t steps)
+{
+    dem_status st = dem_world_prepare(w);
+    if (st != DEM_OK) return st;
+    if (!w->forces_valid) {
+        if (refresh_list(w)) return DEM_ERR_NOMEM;
+        dem_forces_compute(w);
+        w->forces_valid = 1;
+    }
+    for (uint64_t s = 0; s < steps; ++s) {
+        int escaped = 0;
+        size_t bad = kick_drift(w, &escaped);
+        w->step++;
+        w->time += w->dt;
+        if (escaped) {
+            w->forces_valid = 0;
+            return fault(w, DEM_ERR_ESCAPED, bad, "granule left the domain");
+        }
+        if (refresh_list(w)) return DEM_ERR_NOMEM;
+        dem_forces_compute(w);
+        bad = kick(w);
+        if (bad != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad, "non-finite state (NaN or infinity)");
+    }
+    return DEM_OK;
+}
+
+void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx), void *ctx)
+{
+    dem_granules_view view = dem_world_granules(w);
+    size_t out = 0;
+    for (size_t i = 0; i < w->n; ++i) {
+        if (!keep(&view, i, ctx)) continue;
+        w->pos[out] = w->pos[i], w->vel[out] = w->vel[i], w->omg[out] = w->omg[i];
+        w->frc[out] = w->frc[i], w->trq[out] = w->trq[i];
+        w->rad[out] = w->rad[i], w->mass[out] = w->mass[i], w->inertia[out] = w->inertia[i];
+        w->inv_mass[out] = w->inv_mass[i], w->inv_inertia[out] = w->inv_inertia[i], w->id[out] = w->id[i];
+        for (int k = 0; k < w->n_walls; ++k) {
+            size_t hl = (size_t)w->walls[k].hist_len;
+            memmove(w->walls[k].hist + out * hl, w->walls[k].hist + i * hl, hl * sizeof(double));
+        }
+        out++;
+    }
+    w->n = out;
+    invalidate(w);
+    w->prepared = 0;
+}
+
+void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega)
+{
+    if (i >= w->n) return;
+    w->vel[i] = velocity;
+    w->omg[i] = omega;
+    w->forces_valid = 0;
+}
+
+void dem_world_freeze(dem_world *w)
+{
+    for (size_t i = 0; i < w->n; ++i) w->vel[i] = w->omg[i] = dem_v3(0, 0, 0);
+    w->forces_valid = 0;
+}
+
+dem_granules_view dem_world_granules(const dem_world *w)
+{
+    return (dem_granules_view){w->n,   w->pos,  w->vel,     w->omg, w->frc, w->trq,
+                               w->rad, w->mass, w->inertia, w->id};
+}
+
+double dem_world_time(const dem_world *w) { return w->time; }
+double dem_world_dt(const dem_world *w) { return w->dt; }
+unsigned dem_world_features(const dem_world *w)
+{
+    unsigned f = w->features;
+    for (int k = 0; k < w->n_walls; ++k) f |= w->walls[k].features;
+    return f;
+}
+const char *dem_world_error(const dem_world *w) { return w->err; }
+const char *dem_world_dt_report(const dem_world *w) { return w->dt_report; }
+
+void dem_world_describe_features(const dem_world *w, char *buf, size_t len)
+{
+    unsigned f = w->features;
+    int used = snprintf(buf, len, "granule-granule: damping %s (%s), tangential %s, rolling %s; periodic axis %s",
+                        f & DEM_FEAT_DAMPING ? "on" : "off", dem_damping_mode_name(w->def.granule.damping),
+                        f & DEM_FEAT_TANGENTIAL ? "on" : "off", f & DEM_FEAT_ROLLING ? "on" : "off",
+                        f & DEM_FEAT_PERIODIC ? (const char *[]){"x", "y", "z"}[w->def.periodic_axis] : "off");
+    for (int k = 0; k < w->n_walls && used > 0 && (size_t)used < len; ++k) {
+        const dem_wall *wl = &w->walls[k];
+        used += snprintf(buf + used, len - used, "; wall %s (%s%s): damping %s, tangential %s, rolling %s",
+                         wl->name, (const char *[]){"plane", "disc", "cylinder"}[wl->def.kind],
+                         wl->def.spin != 0 ? ", moving" : "", wl->features & DEM_FEAT_DAMPING ? "on" : "off",
+                         wl->features & DEM_FEAT_TANGENTIAL ? "on" : "off",
+                         wl->features & DEM_FEAT_ROLLING ? "on" : "off");
+    }
+}

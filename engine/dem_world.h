@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: MIT
+/// @file dem_world.h
+/// The DEM world: granules (spheres), walls, one contact law per contact kind,
+/// velocity-Verlet time stepping, linked-cell Verlet neighbour lists, and
+/// diagnostics. Knows nothing of drums, calibration or files of experiments.
+#ifndef DEM_WORLD_H
+#define DEM_WORLD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dem_contact.h"
+#include "dem_vec.h"
+
+/// Status codes. Recoverable errors return one of these; the message is in
+/// dem_world_error().
+typedef enum dem_status {
+    DEM_OK = 0,
+    DEM_ERR_INVALID = 1,   ///< bad definition or argument
+    DEM_ERR_NOMEM = 2,     ///< allocation failed
+    DEM_ERR_UNSTABLE = 3,  ///< time step above the stability limit
+    DEM_ERR_NONFINITE = 4, ///< NaN or infinity in the state
+    DEM_ERR_ESCAPED = 5,   ///< a granule left the domain
+} dem_status;
+
+/// Lever arm of tangential forces and of the tangential contact velocity.
+typedef enum dem_lever_arm {
+    /// Distance from the centre to the contact point (R_i − h/2 against a
+    /// granule, R_i − h against a wall): a pair turned as a rigid body does
+    /// not slide. Default.
+    DEM_LEVER_CONTACT_POINT = 0,
+    /// R_i, as eq. 7 and 9 are written: a rigidly turning overlapped pair
+    /// slides at h·Ω, an O(h/R) error.
+    DEM_LEVER_RADIUS = 1,
+} dem_lever_arm;
+
+/// Kinds of wall. Walls are never moved by the solver.
+typedef enum dem_wall_kind {
+    DEM_WALL_PLANE = 0,    ///< infinite plane; granules on the side `normal` points to
+    DEM_WALL_DISC = 1,     ///< flat disc of `radius` (an end plate), one-sided like the plane
+    DEM_WALL_CYLINDER = 2, ///< inner surface of a cylinder of `radius` about `axis`
+} dem_wall_kind;
+
+/// Definition of a wall. A wall can spin about `axis` through `point` at
+/// `spin` rad/s (a rotating drum): its surface velocity at a contact point c
+/// is Ω × (c − point).
+typedef struct dem_wall_def {
+    dem_wall_kind kind;
+    dem_vec3 point;   ///< plane: a point on it; disc: its centre; cylinder: a point on the axis
+    dem_vec3 normal;  ///< plane/disc: unit normal towards the granules
+    dem_vec3 axis;    ///< cylinder: unit axis; also the spin axis of any wall
+    double radius;    ///< disc and cylinder radius, m
+    double spin;      ///< angular velocity about `axis`, rad/s
+    dem_contact_params contact; ///< granule–this-wall contact parameters (Table 3)
+    const char *name; ///< for messages, optional
+} dem_wall_def;
+
+/// Definition of a world, with defaults from dem_default_world_def().
+typedef struct dem_world_def {
+    dem_vec3 gravity;               ///< m/s², default (0, −9.81, 0)
+    dem_contact_params granule;     ///< granule–granule contact (Table 3)
+    double dt;                      ///< time step, s; 0 = choose the stable step
+    double dt_safety;               ///< fraction of the stability limit used when choosing, default 0.9
+    dem_vec3 domain_lo, domain_hi;  ///< granules outside are reported escaped
+    int periodic_axis;              ///< −1 none, else 0/1/2: periodic between domain_lo and domain_hi
+    double skin;                    ///< Verlet skin, m; 0 = 0.2 × smallest radius... see dem_world.c
+    dem_lever_arm lever_arm;
+    int threads;                    ///< OpenMP threads; 0 = OpenMP's default
+} dem_world_def;
+
+/// Defaults: gravity −9.81 along y, the paper's Table 3 granule–granule
+/// contact, automatic time step, no periodic axis, a 1 m domain.
+dem_world_def dem_default_world_def(void);
+
+/// Read-only view of the granules, structure of arrays (hot data).
+typedef struct dem_granules_view {
+    size_t count;
+    const dem_vec3 *position, *velocity, *omega, *force, *torque;
+    const double *radius, *mass, *inertia;
+    const uint64_t *id; ///< stable id given at creation (order changes on re-sorting)
+} dem_granules_view;
+
+/// Diagnostics of the current state.
+typedef struct dem_diagnostics {
+    double time;
+    uint64_t step;
+    size_t granules;
+    size_t contacts;           ///< granule–granule contacts (overlap > 0)
+    size_t wall_contacts;      ///< granule–wall contacts
+    double coordination;       ///< mean granule–granule contacts per granule, 2·contacts/N
+    double coordination_walls; ///< mean (granule + wall) contacts per granule
+    double ke_translational;   ///< J
+    double ke_rotational;      ///< J
+    double max_overlap_ratio;  ///< max h/R_min over contacts
+    double potential_elastic;  ///< J, stored in normal, tangential and rolling springs
+} dem_diagnostics;
+
+typedef struct dem_world dem_world;
+
+/// Create a world; NULL only on out-of-memory or a bad definition (then
+/// `err`, if not NULL, receives the message).
+dem_world *dem_world_create(const dem_world_def *def, char *err, size_t err_len);
+void dem_world_destroy(dem_world *w);
+
+/// Add a granule; returns its id, or −1 (message in dem_world_error).
+int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity, dem_vec3 omega, double radius,
+                              double density);
+/// Add a wall; returns its index, or −1.
+int dem_world_add_wall(dem_world *w, const dem_wall_def *def);
+/// Change a wall's spin (rad/s), e.g. to start a drum turning.
+void dem_world_set_wall_spin(dem_world *w, int wall, double spin);
+/// Change the granule–granule or a wall's contact parameters (calibration
+/// candidates); the feature mask is re-derived.
+int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p);
+int dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p);
+
+/// Fix the time step and check it against the stability limit. Called by
+/// the first dem_world_step; call it yourself to see the step chosen.
+dem_status dem_world_prepare(dem_world *w);
+
+/// Advance `steps` time steps. Stops early with a status on a fault (NaN,
+/// escaped granule); the state at the fault is kept for inspection.
+dem_status dem_world_step(dem_world *w, uint64_t steps);
+
+/// Remove granules for which keep(view index) is 0 (e.g. cutting a bed).
+void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx),
+                               void *ctx);
+
+/// Set a granule's velocity and spin (by view index).
+void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega);
+/// Zero every velocity and spin (keeps contact history).
+void dem_world_freeze(dem_world *w);
+
+dem_granules_view dem_world_granules(const dem_world *w);
+dem_diagnostics dem_world_diagnose(const dem_world *w);
+double dem_world_time(const dem_world *w);
+double dem_world_dt(const dem_world *w);
+unsigned dem_world_features(const dem_world *w);
+const char *dem_world_error(const dem_world *w);
+/// Human-readable line on how the time step was chosen.
+const char *dem_world_dt_report(const dem_world *w);
+/// Text listing the effects on and off in this world ("rolling on, ...").
+void dem_world_describe_features(const dem_world *w, char *buf, size_t len);
+
+/// Lightest granule mass and the smallest radius.
+double dem_world_min_mass(const dem_world *w);
+double dem_world_min_radius(const dem_world *w);
+double dem_world_max_radius(const dem_world *w);
+
+#endif
