@@ -3,14 +3,38 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cal_commands.h"
 #include "exp_common.h"
+
+static const char main_help[] =
+    "granucal: calibrate a DEM powder model (linear spring-dashpot with sliding and\n"
+    "rolling friction) from rotating-drum experiments, after Tiscar et al. (2019).\n"
+    "\n"
+    "usage: granucal COMMAND [options]\n"
+    "\n"
+    "commands:\n"
+    "  simulate SCENE.yaml   run one scene file (e.g. the paper's verification test,\n"
+    "                        configs/scenes/verification_two_particles.yaml)\n"
+    "  --version             print the version\n"
+    "\n"
+    "Run `granucal COMMAND --help` for the options of a command.\n";
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} command;
+
+static const command commands[] = {{"simulate", cal_cmd_simulate}};
 
 int main(int argc, char **argv)
 {
-    if (argc > 1 && strcmp(argv[1], "--version") == 0) {
-        printf("granucal %s\n", exp_version());
-        return 0;
+    if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        fputs(main_help, argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
     }
-    fprintf(stderr, "usage: granucal COMMAND ...\n");
+    if (strcmp(argv[1], "--version") == 0) return printf("granucal %s\n", exp_version()), 0;
+    for (size_t k = 0; k < sizeof commands / sizeof *commands; ++k)
+        if (strcmp(argv[1], commands[k].name) == 0) return commands[k].run(argc - 1, argv + 1);
+    fprintf(stderr, "granucal: unknown command '%s'\n\n%s", argv[1], main_help);
     return 2;
 }

@@ -4,11 +4,14 @@
 #include "dem_output.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <hdf5.h>
 
@@ -86,6 +89,10 @@ static void hdf5_reason(char *buf, size_t len)
     text_buf t = {buf, len};
     buf[0] = '\0';
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, &t);
+    // Keep the message on one line (write failures embed a ctime() stamp).
+    for (char *c = buf; *c; c++)
+        if (*c == '\n' || *c == '\t')
+            *c = ' ';
 }
 
 static void put_message(char *err, size_t err_len, const char *msg)
@@ -213,9 +220,31 @@ static int close_handles(dem_h5_writer *w)
     return rc;
 }
 
+// HDF5 1.10 frees a file whose closing flush fails yet keeps its id, and
+// then crashes at exit (HDFFV-11052, fixed in 1.14.1); a full disk makes
+// exactly that flush fail. The file is about to be deleted, so swap its
+// descriptor for an anonymous in-memory file where the last metadata writes
+// land harmlessly (sparse: only those few pages take memory).
+static void redirect_doomed_file(const dem_h5_writer *w)
+{
+    int *fd = NULL;
+    if (w->file < 0 || H5Fget_vfd_handle(w->file, H5P_DEFAULT, (void **)&fd) < 0 || !fd)
+        return;
+    char name[64];
+    snprintf(name, sizeof name, "/granucal-dem-output-%ld-%p", (long)getpid(), (const void *)w);
+    int scratch = shm_open(name, O_RDWR | O_CREAT | O_EXCL, 0600);
+    if (scratch < 0)
+        return; // no /dev/shm: fall back to closing the real file
+    shm_unlink(name);
+    dup2(scratch, *fd);
+    close(scratch);
+}
+
 // Abandon the output: nothing under the final names changes.
 static void discard(dem_h5_writer *w)
 {
+    if (w->failed)
+        redirect_doomed_file(w);
     close_handles(w);
     remove(w->h5_tmp);
     remove(w->xmf_tmp);
@@ -406,7 +435,9 @@ static int create_file(dem_h5_writer *w)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     // Strong close: closing the file closes anything an error path left open.
-    if (fapl < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0) {
+    // sec2 named explicitly: redirect_doomed_file relies on its handle being
+    // a POSIX descriptor.
+    if (fapl < 0 || H5Pset_fapl_sec2(fapl) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0) {
         int rc = fail_h5(w, "cannot set up file access");
         if (fapl >= 0)
             H5Pclose(fapl);

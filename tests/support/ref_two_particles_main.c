@@ -34,7 +34,7 @@ static int parse_positive(const char *s, double *out)
 int main(int argc, char **argv)
 {
     ref_options opt = ref_default_options();
-    for (int a = 1; a < argc; ++a) {
+    for (int a = 1; a < argc; a += 2) { // options come as NAME VALUE pairs
         const char *arg = argv[a];
         const char *val = a + 1 < argc ? argv[a + 1] : NULL;
         if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0)
@@ -69,7 +69,6 @@ int main(int argc, char **argv)
         } else {
             return usage(argv[0]);
         }
-        ++a;
     }
 
     int n = ref_frame_count(opt.duration);

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -319,6 +320,27 @@ static void check_diagnostics(hid_t file, const frame_data *f, size_t count)
     H5Dclose(ds);
 }
 
+// Non-empty frame datasets are chunked and deflated; empty ones contiguous.
+static void check_layout(hid_t file, const char *path, int compressed)
+{
+    hid_t ds = H5Dopen2(file, path, H5P_DEFAULT);
+    assert_true(ds >= 0);
+    hid_t dcpl = H5Dget_create_plist(ds);
+    assert_true(dcpl >= 0);
+    assert_int_equal(H5Pget_layout(dcpl), compressed ? H5D_CHUNKED : H5D_CONTIGUOUS);
+    unsigned flags = 0, level = 0;
+    size_t nvalues = 1;
+    herr_t found = H5Pget_filter_by_id2(dcpl, H5Z_FILTER_DEFLATE, &flags, &nvalues, &level, 0, NULL, NULL);
+    if (compressed) {
+        assert_true(found >= 0);
+        assert_int_equal(level, 4);
+    } else {
+        assert_int_equal(H5Pget_nfilters(dcpl), 0);
+    }
+    H5Pclose(dcpl);
+    H5Dclose(ds);
+}
+
 static hsize_t frame_count(hid_t file)
 {
     hid_t g = H5Gopen2(file, "/frames", H5P_DEFAULT);
@@ -362,6 +384,8 @@ static void test_three_frames_round_trip(void **state)
     for (size_t k = 0; k < 3; k++)
         check_frame(file, k, &f[k]);
     check_diagnostics(file, f, 3);
+    check_layout(file, "/frames/000001/position", 1);
+    check_layout(file, "/frames/000002/id", 1);
     H5Fclose(file);
 
     char *xmf = slurp(fx->xmf);
@@ -402,6 +426,8 @@ static void test_empty_frame(void **state)
     check_frame(file, 0, &f[0]);
     check_frame(file, 1, &f[1]);
     check_diagnostics(file, f, 2);
+    check_layout(file, "/frames/000000/position", 0);
+    check_layout(file, "/frames/000001/position", 1);
     H5Fclose(file);
 
     char *xmf = slurp(fx->xmf);
@@ -538,6 +564,60 @@ static void test_killed_run_keeps_previous_output(void **state)
     H5Fclose(file);
 }
 
+// Child: with the file size limit far below one frame, an HDF5 write must
+// fail, and close must report it by file name and leave nothing behind.
+static int write_past_size_limit(const char *h5)
+{
+    enum { BIG = 50000 };
+    static dem_vec3 v[BIG];
+    static double r[BIG];
+    static uint64_t id[BIG];
+    uint64_t x = 88172645463325252u; // xorshift: data that deflate cannot shrink
+    for (size_t i = 0; i < BIG; i++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        v[i] = dem_v3((double)x, (double)(x >> 3), (double)(x >> 5));
+        r[i] = (double)(x >> 7);
+        id[i] = x;
+    }
+    dem_granules_view g = {.count = BIG, .position = v, .velocity = v, .omega = v, .radius = r, .id = id};
+    dem_diagnostics d = {.granules = BIG};
+    struct rlimit lim = {64 * 1024, 64 * 1024};
+    signal(SIGXFSZ, SIG_IGN); // turn the signal into EFBIG from write()
+    if (setrlimit(RLIMIT_FSIZE, &lim) != 0)
+        return 10;
+    char err[512] = "";
+    dem_h5_writer *w = dem_h5_open(h5, err, sizeof err);
+    if (!w)
+        return 11;
+    int failed = 0;
+    for (int k = 0; k < 4 && !failed; k++)
+        failed = dem_h5_write_frame(w, k, &g, &d) != 0;
+    if (failed && !strstr(dem_h5_error(w), h5))
+        return 12;
+    if (dem_h5_close(w, err, sizeof err) == 0)
+        return 13;
+    if (!strstr(err, h5))
+        return 14;
+    return 0;
+}
+
+static void test_write_failure_is_reported(void **state)
+{
+    fixture *fx = *state;
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0)
+        _exit(write_past_size_limit(fx->h5));
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+    assert_false(file_exists(fx->h5));
+    assert_false(file_exists(fx->xmf));
+    assert_int_equal(dir_has_suffix(fx->dir, ".tmp"), 0);
+}
+
 static void test_sidecar_name_without_h5_suffix(void **state)
 {
     fixture *fx = *state;
@@ -563,6 +643,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_open_bad_directory, setup, teardown),
         cmocka_unit_test_setup_teardown(test_bad_arguments_leave_writer_usable, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_run_keeps_previous_output, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_write_failure_is_reported, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sidecar_name_without_h5_suffix, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,9 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_commands.h
+/// The sub-commands of granucal; each parses its own options.
+#ifndef CAL_COMMANDS_H
+#define CAL_COMMANDS_H
+
+int cal_cmd_simulate(int argc, char **argv);
+
+#endif

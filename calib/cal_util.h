@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_util.h
+/// Small shared helpers of the granucal command: files written atomically,
+/// directories, wall-clock time.
+#ifndef CAL_UTIL_H
+#define CAL_UTIL_H
+
+#include <stdio.h>
+
+/// Create a directory and its parents; 0 on success, else a message.
+int cal_mkdirs(const char *path, char *err, size_t err_len);
+
+/// A file written under a temporary name and renamed into place on commit,
+/// so a killed run never leaves a half-written file under the final name.
+typedef struct cal_atomic_file {
+    FILE *f;
+    char path[1024], tmp[1040];
+} cal_atomic_file;
+
+int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len);
+int cal_atomic_commit(cal_atomic_file *a, char *err, size_t err_len);
+void cal_atomic_abort(cal_atomic_file *a);
+
+/// Seconds of wall-clock time since an arbitrary origin.
+double cal_wall_seconds(void);
+
+#endif

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+// Diagnostics of the current state: contacts, coordination number, kinetic
+// and elastic energy, largest overlap. Read-only; called once per output
+// interval, never inside the step loop.
+#include "dem_world_internal.h"
+
+static double spring_energy(const double *hist, unsigned features, const dem_contact_params *p)
+{
+    double e = 0;
+    int slot = 0;
+    if (features & DEM_FEAT_TANGENTIAL) {
+        e += 0.5 * p->k_s * (hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2]);
+        slot = 3;
+    }
+    if (features & DEM_FEAT_ROLLING)
+        e += 0.5 * p->k_r * (hist[slot] * hist[slot] + hist[slot + 1] * hist[slot + 1] + hist[slot + 2] * hist[slot + 2]);
+    return e;
+}
+
+static void pair_diagnostics(const dem_world *w, dem_diagnostics *d)
+{
+    const dem_contact_params *p = &w->def.granule;
+    int hl = w->nl.hist_len;
+    for (size_t i = 0; i < w->n && w->list_valid; ++i)
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
+            size_t j = w->nl.j[k];
+            dem_vec3 dv = dem_world_min_image(w, dem_v3_sub(w->pos[j], w->pos[i]));
+            double h = w->rad[i] + w->rad[j] - dem_v3_norm(dv);
+            if (!(h > 0)) continue;
+            d->contacts++;
+            double rmin = w->rad[i] < w->rad[j] ? w->rad[i] : w->rad[j];
+            if (h / rmin > d->max_overlap_ratio) d->max_overlap_ratio = h / rmin;
+            d->potential_elastic += 0.5 * p->k_n * h * h + spring_energy(w->nl.hist + k * hl, w->features, p);
+        }
+}
+
+static double wall_overlap(const dem_wall_def *wd, dem_vec3 p, double r)
+{
+    if (wd->kind == DEM_WALL_CYLINDER) {
+        dem_vec3 d = dem_v3_sub(p, wd->point);
+        dem_vec3 radial = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
+        return r + dem_v3_norm(radial) - wd->radius;
+    }
+    double dist = dem_v3_dot(dem_v3_sub(p, wd->point), wd->normal);
+    if (wd->kind == DEM_WALL_DISC) {
+        dem_vec3 foot = dem_v3_axpy(-dist, wd->normal, p);
+        if (dem_v3_norm(dem_v3_sub(foot, wd->point)) > wd->radius) return -1;
+    }
+    return r - dist;
+}
+
+static void wall_diagnostics(const dem_world *w, dem_diagnostics *d)
+{
+    for (int k = 0; k < w->n_walls; ++k) {
+        const dem_wall *wl = &w->walls[k];
+        for (size_t i = 0; i < w->n; ++i) {
+            double h = wall_overlap(&wl->def, w->pos[i], w->rad[i]);
+            if (!(h > 0)) continue;
+            d->wall_contacts++;
+            if (h / w->rad[i] > d->max_overlap_ratio) d->max_overlap_ratio = h / w->rad[i];
+            d->potential_elastic += 0.5 * wl->def.contact.k_n * h * h +
+                                    spring_energy(wl->hist + i * (size_t)wl->hist_len, wl->features, &wl->def.contact);
+        }
+    }
+}
+
+dem_diagnostics dem_world_diagnose(const dem_world *w)
+{
+    dem_diagnostics d = {0};
+    d.time = w->time;
+    d.step = w->step;
+    d.granules = w->n;
+    for (size_t i = 0; i < w->n; ++i) {
+        d.ke_translational += 0.5 * w->mass[i] * dem_v3_norm2(w->vel[i]);
+        d.ke_rotational += 0.5 * w->inertia[i] * dem_v3_norm2(w->omg[i]);
+    }
+    pair_diagnostics(w, &d);
+    wall_diagnostics(w, &d);
+    if (w->n) {
+        d.coordination = 2.0 * (double)d.contacts / (double)w->n;
+        d.coordination_walls = (2.0 * (double)d.contacts + (double)d.wall_contacts) / (double)w->n;
+    }
+    return d;
+}
