@@ -287,7 +287,7 @@ dem_status dem_world_prepare(dem_world *w)
         return DEM_OK;
     }
     dem_stability st = dem_stability_apriori(w);
-    if (w->def.dt > 0 && w->def.dt > st.dt_limit) {
+    if (w->def.dt > 0 && w->def.dt > st.dt_limit && !w->def.allow_unstable_dt) {
         dem_world_set_error(w,
                             "time step %g s (%.3f of dt_crit = sqrt(m_min/k_n) = %g s, eq. 14) is above the "
                             "stability limit %g s (%.3f of dt_crit): %s. Use a step <= %g s or leave dt unset.",

@@ -66,6 +66,9 @@ typedef struct dem_world_def {
     double skin;                    ///< Verlet skin, m; 0 = 0.2 × smallest radius... see dem_world.c
     dem_lever_arm lever_arm;
     int threads;                    ///< OpenMP threads; 0 = OpenMP's default
+    /// Accept a configured dt above the stability limit. Only for studies of
+    /// the limit itself (tests/stability); never set by configs.
+    int allow_unstable_dt;
 } dem_world_def;
 
 /// Defaults: gravity −9.81 along y, the paper's Table 3 granule–granule
