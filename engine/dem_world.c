@@ -295,6 +295,7 @@ dem_status dem_world_prepare(dem_world *w)
                             st.why, st.dt_limit);
         return DEM_ERR_UNSTABLE;
     }
+    w->dt_limit = st.dt_limit;
     w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * st.dt_limit;
     snprintf(w->dt_report, sizeof w->dt_report,
              "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = sqrt(m_min/k_n) = %.4g s; the paper uses 0.6); "
@@ -303,6 +304,8 @@ dem_status dem_world_prepare(dem_world *w)
              w->def.dt > 0 ? " (step as configured)" : "; step chosen at dt_safety of it");
     w->prepared = 1;
     w->forces_valid = 0;
+    // Build the list now so diagnostics before the first step see contacts.
+    if (dem_nl_rebuild(w)) return DEM_ERR_NOMEM;
     return DEM_OK;
 }
 
@@ -439,6 +442,7 @@ dem_granules_view dem_world_granules(const dem_world *w)
 
 double dem_world_time(const dem_world *w) { return w->time; }
 double dem_world_dt(const dem_world *w) { return w->dt; }
+double dem_world_dt_limit(const dem_world *w) { return w->dt_limit; }
 unsigned dem_world_features(const dem_world *w)
 {
     unsigned f = w->features;

@@ -138,6 +138,8 @@ dem_granules_view dem_world_granules(const dem_world *w);
 dem_diagnostics dem_world_diagnose(const dem_world *w);
 double dem_world_time(const dem_world *w);
 double dem_world_dt(const dem_world *w);
+/// The stability limit found by dem_world_prepare (s); 0 before it.
+double dem_world_dt_limit(const dem_world *w);
 unsigned dem_world_features(const dem_world *w);
 const char *dem_world_error(const dem_world *w);
 /// Human-readable line on how the time step was chosen.

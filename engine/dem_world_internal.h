@@ -58,7 +58,7 @@ struct dem_world {
     int list_valid;
     uint64_t rebuilds;
 
-    double time, dt, lever_factor;
+    double time, dt, dt_limit, lever_factor;
     uint64_t step;
     int prepared, forces_valid;
     char err[512];
