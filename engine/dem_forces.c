@@ -62,7 +62,7 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
 static inline void pair_loop(dem_world *restrict w, const unsigned mask)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < n; ++i)
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask);
 }
@@ -130,7 +130,7 @@ static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_
 static inline void wall_loop(dem_world *restrict w, const dem_wall *wall, const unsigned mask)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < n; ++i) wall_force(w, wall, i, mask);
 }
 
@@ -168,7 +168,7 @@ static const wall_loop_fn wall_loops[8] = {wall_loop_0, wall_loop_1, wall_loop_2
 static void gather(dem_world *restrict w)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < n; ++i) {
         dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {

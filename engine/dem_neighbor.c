@@ -236,13 +236,13 @@ int dem_nl_rebuild(dem_world *w)
         return dem_world_set_error(w, "out of memory building the cell grid");
     }
     start[0] = 0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < n; ++i) start[i + 1] = scan_row(w, &g, i, NULL);
     for (size_t i = 0; i < n; ++i) start[i + 1] += start[i];
     nl->count = start[n];
     int fail = ensure_pairs(w, nl->count);
     if (!fail) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
         for (size_t i = 0; i < n; ++i) {
             scan_row(w, &g, i, nl->j + start[i]);
             sort_row(nl->j + start[i], start[i + 1] - start[i]);
@@ -262,7 +262,7 @@ int dem_nl_rebuild(dem_world *w)
 double dem_nl_max_displacement2(const dem_world *w)
 {
     double m = 0;
-#pragma omp parallel for reduction(max : m) schedule(static)
+#pragma omp parallel for reduction(max : m) schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
         double d2 = dem_v3_norm2(dem_world_min_image(w, dem_v3_sub(w->pos[i], w->pos_at_build[i])));
         m = d2 > m ? d2 : m;

@@ -316,7 +316,7 @@ static size_t kick_drift(dem_world *restrict w, int *escaped)
     const dem_vec3 g = w->def.gravity, lo = w->def.domain_lo, hi = w->def.domain_hi;
     const int pa = w->def.periodic_axis;
     size_t first_bad = SIZE_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
+#pragma omp parallel for schedule(static) reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
         dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
         w->vel[i] = v;
@@ -341,7 +341,7 @@ static size_t kick(dem_world *restrict w)
     const double h = 0.5 * w->dt;
     const dem_vec3 g = w->def.gravity;
     size_t first_bad = SIZE_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
+#pragma omp parallel for schedule(static) reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
         dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
         dem_vec3 o = dem_v3_axpy(h * w->inv_inertia[i], w->trq[i], w->omg[i]);

@@ -8,6 +8,10 @@
 
 #define DEM_MAX_WALLS 8
 
+// Below this many granules a step is a few microseconds of work and starting
+// OpenMP threads would cost more than it saves.
+#define DEM_OMP_MIN_GRANULES 512
+
 // Half neighbour list in CSR form: row i holds the j > i within
 // R_i + R_j + skin, sorted by j, with each pair's history next to it.
 typedef struct dem_neighbor_list {
