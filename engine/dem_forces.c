@@ -45,10 +45,10 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
     s.vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)),
                         dem_v3_sub(w->vel[j], dem_v3_cross(dem_v3_scale(wj, aj), n)));
     s.wrel = dem_v3_sub(wi, wj);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * w->dt;
+    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * w->hist_dt;
     s.reduced_mass = 1.0 / (w->inv_mass[i] + w->inv_mass[j]);
     s.reduced_radius = ri * rj / rsum;
-    s.dt = w->dt;
+    s.dt = w->hist_dt;
     dem_contact_out out;
     dem_contact_eval(&w->gg, &s, hist, &out, mask);
     w->pair_f[k] = out.force;
@@ -115,10 +115,10 @@ static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_
     s.overlap = t.overlap;
     s.vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)), v_wall);
     s.wrel = dem_v3_sub(wi, spin);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, spin), n) * w->dt;
+    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, spin), n) * w->hist_dt;
     s.reduced_mass = w->mass[i]; // infinite wall mass: m* = m_i
     s.reduced_radius = r;        // infinite wall radius: R* = R_i
-    s.dt = w->dt;
+    s.dt = w->hist_dt;
     dem_contact_out out;
     dem_contact_eval(&wall->coeffs, &s, hist, &out, mask);
     w->frc[i] = dem_v3_add(w->frc[i], out.force);

@@ -152,6 +152,7 @@ static void carry_history(dem_neighbor_list *nw, const dem_neighbor_list *old, s
 {
     int hl = nw->hist_len;
     size_t k = nw->start[i], kend = nw->start[i + 1];
+    if (kend == k || hl == 0) return; // no pairs or no history: nothing to carry (hist may be NULL)
     memset(nw->hist + k * hl, 0, (kend - k) * hl * sizeof(double));
     if (!old->start || i >= n_old_rows || old->hist_len != hl || hl == 0) return;
     size_t o = old->start[i], oend = old->start[i + 1];

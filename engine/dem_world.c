@@ -379,7 +379,9 @@ dem_status dem_world_step(dem_world *w, uint64_t steps)
     if (st != DEM_OK) return st;
     if (!w->forces_valid) {
         if (refresh_list(w)) return DEM_ERR_NOMEM;
+        w->hist_dt = w->moved ? w->dt : 0.0; // re-evaluation at an unchanged configuration: springs stay
         dem_forces_compute(w);
+        w->moved = 0;
         w->forces_valid = 1;
     }
     for (uint64_t s = 0; s < steps; ++s) {
@@ -389,10 +391,13 @@ dem_status dem_world_step(dem_world *w, uint64_t steps)
         w->time += w->dt;
         if (escaped) {
             w->forces_valid = 0;
+            w->moved = 1;
             return fault(w, DEM_ERR_ESCAPED, bad, "granule left the domain");
         }
         if (refresh_list(w)) return DEM_ERR_NOMEM;
+        w->hist_dt = w->dt;
         dem_forces_compute(w);
+        w->moved = 0;
         bad = kick(w);
         if (bad != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad, "non-finite state (NaN or infinity)");
     }

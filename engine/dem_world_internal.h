@@ -63,6 +63,8 @@ struct dem_world {
     uint64_t rebuilds;
 
     double time, dt, dt_limit, lever_factor;
+    double hist_dt; // dt when positions moved since the last force evaluation, else 0
+    int moved;
     uint64_t step;
     int prepared, forces_valid;
     char err[512];
