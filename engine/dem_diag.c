@@ -34,27 +34,12 @@ static void pair_diagnostics(const dem_world *w, dem_diagnostics *d)
         }
 }
 
-static double wall_overlap(const dem_wall_def *wd, dem_vec3 p, double r)
-{
-    if (wd->kind == DEM_WALL_CYLINDER) {
-        dem_vec3 d = dem_v3_sub(p, wd->point);
-        dem_vec3 radial = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
-        return r + dem_v3_norm(radial) - wd->radius;
-    }
-    double dist = dem_v3_dot(dem_v3_sub(p, wd->point), wd->normal);
-    if (wd->kind == DEM_WALL_DISC) {
-        dem_vec3 foot = dem_v3_axpy(-dist, wd->normal, p);
-        if (dem_v3_norm(dem_v3_sub(foot, wd->point)) > wd->radius) return -1;
-    }
-    return r - dist;
-}
-
 static void wall_diagnostics(const dem_world *w, dem_diagnostics *d)
 {
     for (int k = 0; k < w->n_walls; ++k) {
         const dem_wall *wl = &w->walls[k];
         for (size_t i = 0; i < w->n; ++i) {
-            double h = wall_overlap(&wl->def, w->pos[i], w->rad[i]);
+            double h = dem_wall_geometry(&wl->def, w->pos[i], w->rad[i]).overlap;
             if (!(h > 0)) continue;
             d->wall_contacts++;
             if (h / w->rad[i] > d->max_overlap_ratio) d->max_overlap_ratio = h / w->rad[i];

@@ -67,40 +67,12 @@ static inline void pair_loop(dem_world *restrict w, const unsigned mask)
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask);
 }
 
-// Geometry of a granule against a wall: overlap, unit normal from the granule
-// towards the wall, and the contact point on the wall surface.
-typedef struct wall_touch {
-    double overlap;
-    dem_vec3 normal, point;
-} wall_touch;
-
-static inline wall_touch wall_geometry(const dem_wall_def *wd, dem_vec3 p, double r)
-{
-    wall_touch t = {-1.0, {0, 0, 0}, {0, 0, 0}};
-    if (wd->kind == DEM_WALL_CYLINDER) {
-        dem_vec3 d = dem_v3_sub(p, wd->point);
-        dem_vec3 radial = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
-        double rho = dem_v3_norm(radial);
-        if (rho <= 0.0) return t;
-        t.normal = dem_v3_scale(radial, 1.0 / rho);
-        t.overlap = r + rho - wd->radius;
-        t.point = dem_v3_axpy(wd->radius - rho, t.normal, p);
-        return t;
-    }
-    double dist = dem_v3_dot(dem_v3_sub(p, wd->point), wd->normal);
-    t.normal = dem_v3_neg(wd->normal);
-    t.overlap = r - dist;
-    t.point = dem_v3_axpy(-dist, wd->normal, p);
-    if (wd->kind == DEM_WALL_DISC && dem_v3_norm(dem_v3_sub(t.point, wd->point)) > wd->radius) t.overlap = -1.0;
-    return t;
-}
-
 static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_t i, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
     double *hist = wall->hist + i * (size_t)hl;
     const double r = w->rad[i];
-    wall_touch t = wall_geometry(&wall->def, w->pos[i], r);
+    dem_wall_touch t = dem_wall_geometry(&wall->def, w->pos[i], r);
     if (!(t.overlap > 0.0)) {
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         return;

@@ -42,22 +42,9 @@ static size_t collect_contacts(dem_world *w, contact_geo **out)
         }
     for (int k = 0; k < w->n_walls; ++k)
         for (size_t i = 0; i < w->n; ++i) {
-            // Treat every granule within one radius of a wall as touching it.
-            const dem_wall_def *wd = &w->walls[k].def;
-            double dist;
-            dem_vec3 n;
-            if (wd->kind == DEM_WALL_CYLINDER) {
-                dem_vec3 d = dem_v3_sub(w->pos[i], wd->point);
-                dem_vec3 rad = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
-                double rho = dem_v3_norm(rad);
-                if (rho <= 0) continue;
-                n = dem_v3_scale(rad, 1 / rho);
-                dist = wd->radius - rho;
-            } else {
-                dist = dem_v3_dot(dem_v3_sub(w->pos[i], wd->point), wd->normal);
-                n = dem_v3_neg(wd->normal);
-            }
-            double h = w->rad[i] - dist;
+            dem_wall_touch t = dem_wall_geometry(&w->walls[k].def, w->pos[i], w->rad[i]);
+            double h = t.overlap;
+            dem_vec3 n = t.normal;
             if (!(h > 0)) continue;
             c[m++] = (contact_geo){i, SIZE_MAX, n, w->rad[i] - w->lever_factor * h, 0, w->rad[i], w->mass[i],
                                    &w->walls[k].def.contact};

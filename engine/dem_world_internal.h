@@ -71,6 +71,34 @@ struct dem_world {
     char dt_report[512];
 };
 
+// Geometry of a granule against a wall: overlap, unit normal from the granule
+// towards the wall, and the contact point on the wall surface.
+typedef struct dem_wall_touch {
+    double overlap;
+    dem_vec3 normal, point;
+} dem_wall_touch;
+
+static inline dem_wall_touch dem_wall_geometry(const dem_wall_def *wd, dem_vec3 p, double r)
+{
+    dem_wall_touch t = {-1.0, {0, 0, 0}, {0, 0, 0}};
+    if (wd->kind == DEM_WALL_CYLINDER) {
+        dem_vec3 d = dem_v3_sub(p, wd->point);
+        dem_vec3 radial = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
+        double rho = dem_v3_norm(radial);
+        if (rho <= 0.0) return t;
+        t.normal = dem_v3_scale(radial, 1.0 / rho);
+        t.overlap = r + rho - wd->radius;
+        t.point = dem_v3_axpy(wd->radius - rho, t.normal, p);
+        return t;
+    }
+    double dist = dem_v3_dot(dem_v3_sub(p, wd->point), wd->normal);
+    t.normal = dem_v3_neg(wd->normal);
+    t.overlap = r - dist;
+    t.point = dem_v3_axpy(-dist, wd->normal, p);
+    if (wd->kind == DEM_WALL_DISC && dem_v3_norm(dem_v3_sub(t.point, wd->point)) > wd->radius) t.overlap = -1.0;
+    return t;
+}
+
 // dem_neighbor.c
 int dem_nl_rebuild(dem_world *w);
 void dem_nl_free(dem_neighbor_list *nl);

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The test command: set up, build, run every ctest label, then rebuild with
-# AddressSanitizer + UndefinedBehaviorSanitizer and run the unit tests under it.
+# AddressSanitizer + UndefinedBehaviorSanitizer and run the unit and physics tests under it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash .ci/setup
@@ -8,4 +8,4 @@ ctest --test-dir build --output-on-failure -j1
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DGRANUCAL_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$(nproc)" >/dev/null
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-asan --output-on-failure -L unit -j1
+  ctest --test-dir build-asan --output-on-failure -L "unit|physics" -j1
