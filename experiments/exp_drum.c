@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+// The rotating drum: build, pour, settle, measure.
+#include "exp_drum.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_scaling.h"
+
+#define POUR_LAYER_TIME 0.12   // s a poured layer falls before the next
+#define SETTLE_MAX_TIME 2.0    // s
+#define SETTLE_KE_RATIO 1e-6   // KE per granule over m̄·g·d50 at rest
+
+exp_drum_def exp_default_drum_def(void)
+{
+    exp_drum_def d;
+    memset(&d, 0, sizeof d);
+    d.diameter = 0.1;
+    d.depth = 0.044;
+    d.fill = 0.43;
+    d.periodic = 0;
+    d.lambda = 64;
+    d.gsd = dem_default_gsd();
+    d.density = 1800;
+    d.granule = dem_default_world_def().granule;
+    d.wall = d.granule;
+    d.wall.k_n = d.wall.k_s = d.wall.k_r = 2 * d.granule.k_n; // Table 3: springs in series
+    d.end_plate = d.wall;
+    d.bed_solid_fraction = 0.6;
+    d.seed = 1;
+    return d;
+}
+
+int exp_drum_check(const exp_drum_def *d, char *msg, size_t len)
+{
+    char sub[256];
+    if (!(d->diameter > 0)) return snprintf(msg, len, "drum.diameter = %g: must be > 0", d->diameter), 1;
+    if (!(d->depth > 0)) return snprintf(msg, len, "drum.depth = %g: must be > 0", d->depth), 1;
+    if (!(d->fill > 0 && d->fill < 1)) return snprintf(msg, len, "drum.fill = %g: must be in (0, 1)", d->fill), 1;
+    if (!(d->bed_solid_fraction > 0 && d->bed_solid_fraction < 0.75))
+        return snprintf(msg, len, "bed_solid_fraction = %g: must be in (0, 0.75)", d->bed_solid_fraction), 1;
+    if (!(d->density > 0)) return snprintf(msg, len, "density = %g: must be > 0", d->density), 1;
+    if (dem_scale_check(d->lambda, sub, sizeof sub)) return snprintf(msg, len, "%s", sub), 1;
+    if (dem_gsd_check(&d->gsd, sub, sizeof sub)) return snprintf(msg, len, "%s", sub), 1;
+    if (dem_contact_params_check(&d->granule, sub, sizeof sub))
+        return snprintf(msg, len, "granule_contact.%s", sub), 1;
+    if (dem_contact_params_check(&d->wall, sub, sizeof sub)) return snprintf(msg, len, "wall_contact.%s", sub), 1;
+    return 0;
+}
+
+static dem_world *create_drum(const exp_drum_def *d, char *err, size_t len)
+{
+    double r = 0.5 * d->diameter;
+    dem_world_def def = dem_default_world_def();
+    def.granule = dem_scale_contact(&d->granule, d->lambda);
+    def.domain_lo = dem_v3(-1.2 * r, -1.2 * r, d->periodic ? 0 : -0.1 * d->depth);
+    def.domain_hi = dem_v3(1.2 * r, 1.2 * r, d->periodic ? d->depth : 1.1 * d->depth);
+    def.periodic_axis = d->periodic ? 2 : -1;
+    dem_world *w = dem_world_create(&def, err, len);
+    if (!w) return NULL;
+    dem_wall_def cyl = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 0, 1}, .radius = r,
+                        .contact = dem_scale_contact(&d->wall, d->lambda), .name = "drum"};
+    int ok = dem_world_add_wall(w, &cyl) >= 0;
+    if (!d->periodic) {
+        dem_contact_params plate = dem_scale_contact(&d->end_plate, d->lambda);
+        dem_wall_def front = {.kind = DEM_WALL_DISC, .point = {0, 0, 0}, .normal = {0, 0, 1}, .axis = {0, 0, 1},
+                              .radius = r, .contact = plate, .name = "front plate"};
+        dem_wall_def back = front;
+        back.point = dem_v3(0, 0, d->depth), back.normal = dem_v3(0, 0, -1), back.name = "back plate";
+        ok = ok && dem_world_add_wall(w, &front) >= 0 && dem_world_add_wall(w, &back) >= 0;
+    }
+    if (!ok) {
+        snprintf(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
+    return w;
+}
+
+// Top of the bed so far (highest granule top), or the drum bottom.
+static double bed_top(const dem_world *w, double drum_r)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double top = -drum_r;
+    for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y + g.radius[i]);
+    return top;
+}
+
+// Place granules [next, n) on a lattice of pitch d_max in the free part of
+// the drum above the bed; returns how many were placed.
+static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *diam, size_t next, size_t n, double pitch)
+{
+    double r = 0.5 * d->diameter, y0 = bed_top(w, r) + pitch, inner = r - 0.55 * pitch;
+    double z0 = d->periodic ? 0.5 * pitch : 0.6 * pitch, z1 = d->depth - (d->periodic ? 0.5 * pitch : 0.6 * pitch);
+    size_t placed = 0;
+    for (double y = y0; y < inner && next + placed < n; y += pitch)
+        for (double x = -inner; x <= inner && next + placed < n; x += pitch)
+            for (double z = z0; z <= z1 + 1e-12 && next + placed < n; z += pitch) {
+                if (x * x + y * y > inner * inner) continue;
+                size_t k = next + placed;
+                dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0);
+                double rho = dem_scale_density(d->density, d->lambda);
+                if (dem_world_add_granule(w, dem_v3(x, y, z), v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
+                placed++;
+            }
+    return placed;
+}
+
+static double ke_total(const dem_world *w)
+{
+    dem_diagnostics g = dem_world_diagnose(w);
+    return g.ke_translational + g.ke_rotational;
+}
+
+static int run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
+{
+    uint64_t chunk = (uint64_t)(0.01 / dem_world_dt(w)) + 1;
+    double t_end = dem_world_time(w) + seconds;
+    while (dem_world_time(w) < t_end) {
+        if (dem_world_step(w, chunk) != DEM_OK) return 1;
+        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
+    }
+    return 0;
+}
+
+dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *ctx, char *err, size_t len)
+{
+    if (exp_drum_check(d, err, len)) return NULL;
+    dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
+    double r = 0.5 * d->diameter, bed_volume = d->fill * DEM_PI * r * r * d->depth;
+    size_t n = dem_gsd_count_for_volume(&gsd, bed_volume * d->bed_solid_fraction);
+    double *diam = malloc(n * sizeof *diam);
+    dem_world *w = diam ? create_drum(d, err, len) : NULL;
+    if (!w || dem_gsd_sample(&gsd, d->seed, n, diam)) {
+        if (diam && w) snprintf(err, len, "cannot sample the granule sizes");
+        free(diam);
+        dem_world_destroy(w);
+        return NULL;
+    }
+    double pitch = 1.05 * dem_gsd_max_diameter(&gsd);
+    for (size_t next = 0; next < n;) {
+        size_t placed = place_layer(w, d, diam, next, n, pitch);
+        if (placed == 0 || dem_world_prepare(w) != DEM_OK || run_for(w, POUR_LAYER_TIME, progress, ctx, "pour")) {
+            if (placed) snprintf(err, len, "%s", dem_world_error(w));
+            else snprintf(err, len, "the drum is too small to pour %zu granules (placed %zu)", n, next);
+            free(diam);
+            dem_world_destroy(w);
+            return NULL;
+        }
+        next += placed;
+    }
+    free(diam);
+    // Settle: until KE per granule < SETTLE_KE_RATIO · m̄ g d50.
+    dem_granules_view g = dem_world_granules(w);
+    double mass = 0;
+    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
+    double threshold = SETTLE_KE_RATIO * mass * 9.81 * gsd.median_diameter;
+    for (double t = 0; t < SETTLE_MAX_TIME && ke_total(w) > threshold; t += 0.05)
+        if (run_for(w, 0.05, progress, ctx, "settle")) {
+            snprintf(err, len, "%s", dem_world_error(w));
+            dem_world_destroy(w);
+            return NULL;
+        }
+    return w;
+}
+
+int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px,
+                         exp_drum_measure *out)
+{
+    double r = 0.5 * d->diameter;
+    exp_raster *img = exp_raster_create(r, pixel);
+    if (!img) return 1;
+    dem_granules_view g = dem_world_granules(w);
+    double *x = malloc(g.count * sizeof *x), *y = malloc(g.count * sizeof *y);
+    for (size_t i = 0; x && y && i < g.count; ++i) x[i] = g.position[i].x, y[i] = g.position[i].y;
+    int rc = !x || !y;
+    if (!rc) {
+        exp_raster_paint_discs(img, g.count, x, y, g.radius);
+        rc = exp_raster_close(img, closing_px);
+        out->csa_percent = exp_raster_csa_percent(img, r);
+        exp_angle a;
+        rc = rc || exp_raster_surface_angle(img, r, 0.6, &a);
+        out->angle_deg = fabs(a.angle_deg);
+        out->angle_fit_sd_m = a.residual_sd;
+    }
+    free(x), free(y);
+    exp_raster_free(img);
+    return rc;
+}
