@@ -78,30 +78,55 @@ static dem_world *create_drum(const exp_drum_def *d, char *err, size_t len)
     return w;
 }
 
-// Top of the bed so far (highest granule top), or the drum bottom.
-static double bed_top(const dem_world *w, double drum_r)
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+// Height below which 98 % of the granule tops lie: the bed's surface,
+// ignoring the few granules still bouncing above it.
+static double bed_surface(const dem_world *w, double drum_r)
 {
     dem_granules_view g = dem_world_granules(w);
-    double top = -drum_r;
-    for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y + g.radius[i]);
+    if (g.count == 0) return -drum_r;
+    double *tops = malloc(g.count * sizeof *tops);
+    if (!tops) return drum_r;
+    for (size_t i = 0; i < g.count; ++i) tops[i] = g.position[i].y + g.radius[i];
+    qsort(tops, g.count, sizeof *tops, cmp_double);
+    double top = tops[(size_t)(0.98 * (double)(g.count - 1))];
+    free(tops);
     return top;
+}
+
+// Does a granule of radius r at p overlap any granule above height `above`?
+static int overlaps(const dem_world *w, dem_vec3 p, double r, double above)
+{
+    dem_granules_view g = dem_world_granules(w);
+    for (size_t i = 0; i < g.count; ++i) {
+        if (g.position[i].y + g.radius[i] < above) continue;
+        double reach = r + g.radius[i];
+        if (dem_v3_norm2(dem_v3_sub(g.position[i], p)) < reach * reach) return 1;
+    }
+    return 0;
 }
 
 // Place granules [next, n) on a lattice of pitch d_max in the free part of
 // the drum above the bed; returns how many were placed.
 static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *diam, size_t next, size_t n, double pitch)
 {
-    double r = 0.5 * d->diameter, y0 = bed_top(w, r) + pitch, inner = r - 0.55 * pitch;
+    double r = 0.5 * d->diameter, y0 = bed_surface(w, r) + 0.5 * pitch, inner = r - 0.55 * pitch;
     double z0 = d->periodic ? 0.5 * pitch : 0.6 * pitch, z1 = d->depth - (d->periodic ? 0.5 * pitch : 0.6 * pitch);
+    double rho = dem_scale_density(d->density, d->lambda);
     size_t placed = 0;
     for (double y = y0; y < inner && next + placed < n; y += pitch)
         for (double x = -inner; x <= inner && next + placed < n; x += pitch)
             for (double z = z0; z <= z1 + 1e-12 && next + placed < n; z += pitch) {
-                if (x * x + y * y > inner * inner) continue;
                 size_t k = next + placed;
+                dem_vec3 p = dem_v3(x, y, z);
+                if (x * x + y * y > inner * inner || overlaps(w, p, 0.5 * diam[k], y0 - pitch)) continue;
                 dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0);
-                double rho = dem_scale_density(d->density, d->lambda);
-                if (dem_world_add_granule(w, dem_v3(x, y, z), v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
+                if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
                 placed++;
             }
     return placed;
