@@ -8,7 +8,8 @@
 
 #include "dem_scaling.h"
 
-#define POUR_LAYER_TIME 0.12   // s a poured layer falls before the next
+#define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
+#define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE per granule over m̄·g·d50
 #define SETTLE_MAX_TIME 2.0    // s
 #define SETTLE_KE_RATIO 1e-6   // KE per granule over m̄·g·d50 at rest
 
@@ -129,13 +130,8 @@ static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *dia
                 if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
                 placed++;
             }
+    if (getenv("GRANUCAL_DEBUG_POUR")) fprintf(stderr, "layer: surface %.4f m, placed %zu, total %zu\n", y0, placed, next + placed);
     return placed;
-}
-
-static double ke_total(const dem_world *w)
-{
-    dem_diagnostics g = dem_world_diagnose(w);
-    return g.ke_translational + g.ke_rotational;
 }
 
 static int run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
@@ -145,6 +141,28 @@ static int run_for(dem_world *w, double seconds, exp_progress_fn progress, void 
     while (dem_world_time(w) < t_end) {
         if (dem_world_step(w, chunk) != DEM_OK) return 1;
         if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
+    }
+    return 0;
+}
+
+// Kinetic energy per granule over m̄·g·d50: the bed is at rest when small.
+static double ke_ratio(const dem_world *w, double d50)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double mass = 0;
+    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
+    dem_diagnostics d = dem_world_diagnose(w);
+    return g.count ? (d.ke_translational + d.ke_rotational) / (mass * 9.81 * d50) : 0.0;
+}
+
+// Run in 0.05 s chunks until the KE ratio falls below `ratio` or `max_time`
+// has passed; non-zero on an engine fault.
+static int run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress,
+                          void *ctx, const char *phase)
+{
+    for (double t = 0; t < max_time; t += 0.05) {
+        if (run_for(w, 0.05, progress, ctx, phase)) return 1;
+        if (ke_ratio(w, d50) < ratio) break;
     }
     return 0;
 }
@@ -166,7 +184,8 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     double pitch = 1.05 * dem_gsd_max_diameter(&gsd);
     for (size_t next = 0; next < n;) {
         size_t placed = place_layer(w, d, diam, next, n, pitch);
-        if (placed == 0 || dem_world_prepare(w) != DEM_OK || run_for(w, POUR_LAYER_TIME, progress, ctx, "pour")) {
+        if (placed == 0 || dem_world_prepare(w) != DEM_OK ||
+            run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour")) {
             if (placed) snprintf(err, len, "%s", dem_world_error(w));
             else snprintf(err, len, "the drum is too small to pour %zu granules (placed %zu)", n, next);
             free(diam);
@@ -176,17 +195,11 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
         next += placed;
     }
     free(diam);
-    // Settle: until KE per granule < SETTLE_KE_RATIO · m̄ g d50.
-    dem_granules_view g = dem_world_granules(w);
-    double mass = 0;
-    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
-    double threshold = SETTLE_KE_RATIO * mass * 9.81 * gsd.median_diameter;
-    for (double t = 0; t < SETTLE_MAX_TIME && ke_total(w) > threshold; t += 0.05)
-        if (run_for(w, 0.05, progress, ctx, "settle")) {
-            snprintf(err, len, "%s", dem_world_error(w));
-            dem_world_destroy(w);
-            return NULL;
-        }
+    if (run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
+        snprintf(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
     return w;
 }
 
