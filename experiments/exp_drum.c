@@ -28,7 +28,8 @@ exp_drum_def exp_default_drum_def(void)
     d.wall = d.granule;
     d.wall.k_n = d.wall.k_s = d.wall.k_r = 2 * d.granule.k_n; // Table 3: springs in series
     d.end_plate = d.wall;
-    d.bed_solid_fraction = 0.6;
+    d.pixel = 0;
+    d.closing_px = 2;
     d.seed = 1;
     return d;
 }
@@ -39,8 +40,9 @@ int exp_drum_check(const exp_drum_def *d, char *msg, size_t len)
     if (!(d->diameter > 0)) return snprintf(msg, len, "drum.diameter = %g: must be > 0", d->diameter), 1;
     if (!(d->depth > 0)) return snprintf(msg, len, "drum.depth = %g: must be > 0", d->depth), 1;
     if (!(d->fill > 0 && d->fill < 1)) return snprintf(msg, len, "drum.fill = %g: must be in (0, 1)", d->fill), 1;
-    if (!(d->bed_solid_fraction > 0 && d->bed_solid_fraction < 0.75))
-        return snprintf(msg, len, "bed_solid_fraction = %g: must be in (0, 0.75)", d->bed_solid_fraction), 1;
+    if (!(d->pixel >= 0)) return snprintf(msg, len, "drum.pixel = %g: must be >= 0", d->pixel), 1;
+    if (d->closing_px < 0 || d->closing_px > 50)
+        return snprintf(msg, len, "drum.closing_px = %d: must be in [0, 50]", d->closing_px), 1;
     if (!(d->density > 0)) return snprintf(msg, len, "density = %g: must be > 0", d->density), 1;
     if (dem_scale_check(d->lambda, sub, sizeof sub)) return snprintf(msg, len, "%s", sub), 1;
     if (dem_gsd_check(&d->gsd, sub, sizeof sub)) return snprintf(msg, len, "%s", sub), 1;
@@ -167,39 +169,78 @@ static int run_until_rest(dem_world *w, double d50, double ratio, double max_tim
     return 0;
 }
 
+// Raster resolution of the drum face: a quarter of the median diameter, and
+// a closing of half a median diameter, which fills the pores between
+// granules (as a photograph of a powder shows none) but not the surface.
+static double face_pixel(const exp_drum_def *d) { return d->pixel > 0 ? d->pixel : 0.25 * d->gsd.median_diameter * cbrt(d->lambda); }
+
+// CSA (eq. 20) of the granules whose centres lie at or below y_cut.
+static double csa_below(const dem_world *w, const exp_drum_def *d, double y_cut)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double *x = malloc((g.count + 1) * sizeof *x), *y = malloc((g.count + 1) * sizeof *y), *r = malloc((g.count + 1) * sizeof *r);
+    exp_raster *img = exp_raster_create(0.5 * d->diameter, face_pixel(d));
+    double csa = NAN;
+    if (x && y && r && img) {
+        size_t m = 0;
+        for (size_t i = 0; i < g.count; ++i)
+            if (g.position[i].y <= y_cut) x[m] = g.position[i].x, y[m] = g.position[i].y, r[m++] = g.radius[i];
+        exp_raster_paint_discs(img, m, x, y, r);
+        if (exp_raster_close(img, d->closing_px) == 0) csa = exp_raster_csa_percent(img, 0.5 * d->diameter);
+    }
+    exp_raster_free(img);
+    free(x), free(y), free(r);
+    return csa;
+}
+
+static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return g->position[i].y <= *(double *)ctx; }
+
+// Remove the granules above the height at which the bed's CSA is the fill
+// degree (bisection on the cut height).
+static void cut_to_fill(dem_world *w, const exp_drum_def *d)
+{
+    double lo = -0.5 * d->diameter, hi = 0.5 * d->diameter, target = 100.0 * d->fill;
+    for (int it = 0; it < 40; ++it) {
+        double mid = 0.5 * (lo + hi);
+        if (csa_below(w, d, mid) < target) lo = mid;
+        else hi = mid;
+    }
+    dem_world_remove_granules(w, keep_below, &hi);
+}
+
+static dem_world *fill_failed(dem_world *w, double *diam, char *err, size_t len, const char *why)
+{
+    snprintf(err, len, "drum fill: %s", why ? why : dem_world_error(w));
+    free(diam);
+    dem_world_destroy(w);
+    return NULL;
+}
+
 dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *ctx, char *err, size_t len)
 {
     if (exp_drum_check(d, err, len)) return NULL;
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     double r = 0.5 * d->diameter, bed_volume = d->fill * DEM_PI * r * r * d->depth;
-    size_t n = dem_gsd_count_for_volume(&gsd, bed_volume * d->bed_solid_fraction);
-    double *diam = malloc(n * sizeof *diam);
+    // Enough sizes for a bed three times looser than a dense one; the pour
+    // stops when the bed's CSA reaches the fill degree.
+    size_t cap = 3 * dem_gsd_count_for_volume(&gsd, 0.6 * bed_volume) + 16;
+    double *diam = malloc(cap * sizeof *diam);
     dem_world *w = diam ? create_drum(d, err, len) : NULL;
-    if (!w || dem_gsd_sample(&gsd, d->seed, n, diam)) {
-        if (diam && w) snprintf(err, len, "cannot sample the granule sizes");
-        free(diam);
-        dem_world_destroy(w);
-        return NULL;
-    }
-    double pitch = 1.05 * dem_gsd_max_diameter(&gsd);
-    for (size_t next = 0; next < n;) {
-        size_t placed = place_layer(w, d, diam, next, n, pitch);
-        if (placed == 0 || dem_world_prepare(w) != DEM_OK ||
-            run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour")) {
-            if (placed) snprintf(err, len, "%s", dem_world_error(w));
-            else snprintf(err, len, "the drum is too small to pour %zu granules (placed %zu)", n, next);
-            free(diam);
-            dem_world_destroy(w);
-            return NULL;
-        }
+    if (!w) return fill_failed(w, diam, err, len, "out of memory");
+    if (dem_gsd_sample(&gsd, d->seed, cap, diam)) return fill_failed(w, diam, err, len, "cannot sample sizes");
+    double pitch = 1.05 * dem_gsd_max_diameter(&gsd), target = 100.0 * d->fill;
+    for (size_t next = 0; csa_below(w, d, r) < target;) {
+        size_t placed = next < cap ? place_layer(w, d, diam, next, cap, pitch) : 0;
+        if (placed == 0) return fill_failed(w, diam, err, len, "no room left to pour: the fill degree is too high");
+        if (dem_world_prepare(w) != DEM_OK ||
+            run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
+            return fill_failed(w, diam, err, len, NULL);
         next += placed;
     }
     free(diam);
-    if (run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
-        snprintf(err, len, "%s", dem_world_error(w));
-        dem_world_destroy(w);
-        return NULL;
-    }
+    cut_to_fill(w, d);
+    if (run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle"))
+        return fill_failed(w, NULL, err, len, NULL);
     return w;
 }
 

@@ -27,7 +27,8 @@ typedef struct exp_drum_def {
     dem_contact_params granule; ///< real granule–granule contact (Table 3)
     dem_contact_params wall;    ///< real granule–drum-wall contact (Table 3)
     dem_contact_params end_plate; ///< real granule–end-plate contact (full drum only)
-    double bed_solid_fraction;  ///< solid fraction assumed to count the granules (0.6)
+    double pixel;               ///< raster pixel of the drum face, m; 0 = a quarter of the scaled d50
+    int closing_px;             ///< closing radius in pixels (2: half a median diameter)
     uint64_t seed;
 } exp_drum_def;
 
@@ -41,11 +42,13 @@ int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);
 /// Progress callback: phase name, simulated time, granules; may be NULL.
 typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);
 
-/// Build the drum and fill it: granules are poured in layers into the empty
-/// upper part of the drum, each layer falling before the next is placed,
-/// then the bed settles until its kinetic energy per granule is below
-/// `1e-6 · m̄ g d50` (the work of lifting a mean granule by a millionth of
-/// its median diameter... see exp_drum.c). Returns NULL with a message.
+/// Build the drum and fill it as the lab does, by bed volume: granules are
+/// poured in layers into the empty upper part of the drum, each layer
+/// landing before the next is placed, until the bed's occupied CSA (eq. 20)
+/// reaches the fill degree; the granules above the height where it equals
+/// the fill degree are removed, and the bed settles until its kinetic energy
+/// is below 1e-6 of (its mass)·g·d50. How many granules that takes depends on
+/// how loosely the contact parameters let the bed pack. NULL with a message.
 dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *ctx, char *err, size_t len);
 
 /// Measure the drum face: angle of the free surface and occupied CSA.
