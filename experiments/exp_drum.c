@@ -9,9 +9,9 @@
 #include "dem_scaling.h"
 
 #define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
-#define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE per granule over m̄·g·d50
+#define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE over (bed mass)·g·d50
 #define SETTLE_MAX_TIME 2.0    // s
-#define SETTLE_KE_RATIO 1e-6   // KE per granule over m̄·g·d50 at rest
+#define SETTLE_KE_RATIO 1e-6   // KE over (bed mass)·g·d50 at rest
 
 exp_drum_def exp_default_drum_def(void)
 {
@@ -132,7 +132,6 @@ static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *dia
                 if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
                 placed++;
             }
-    if (getenv("GRANUCAL_DEBUG_POUR")) fprintf(stderr, "layer: surface %.4f m, placed %zu, total %zu\n", y0, placed, next + placed);
     return placed;
 }
 
@@ -147,7 +146,7 @@ static int run_for(dem_world *w, double seconds, exp_progress_fn progress, void 
     return 0;
 }
 
-// Kinetic energy per granule over m̄·g·d50: the bed is at rest when small.
+// Kinetic energy over (bed mass)·g·d50: the bed is at rest when small.
 static double ke_ratio(const dem_world *w, double d50)
 {
     dem_granules_view g = dem_world_granules(w);

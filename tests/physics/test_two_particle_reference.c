@@ -182,23 +182,31 @@ static void test_pair_restitution_each_reading(void **state)
 // rolling (v_x = −a ω_z, the spring oscillating about zero slip), so the mean
 // velocity is v0 / (1 + I/(m a²)): 5/7 v0 for a = R. Tests the tangential
 // spring, the Coulomb limit and the sign and lever of the torque (eq. 6–9).
+// Particle 1 of Table A.1 alone, resting on the floor at its equilibrium
+// overlap m g / k_n, moving at v0 along x and spinning at w0 about z.
+static void single_on_floor(ref_sim *s, int lever, double v0, double w0, double *h_eq)
+{
+    ref_options o = ref_default_options();
+    o.lever = lever;
+    ref_sim_init_table_a1(s, &o);
+    s->n = 1;
+    *h_eq = s->m[0] * 9.81 / s->wall[0].kn;
+    s->x[0] = rv(0.0, s->R[0] - *h_eq, 0.0);
+    s->v[0] = rv(v0, 0.0, 0.0);
+    s->w[0] = rv(0.0, 0.0, w0);
+}
+
 static void test_slide_to_roll(void **state)
 {
     (void)state;
     for (int lever = 0; lever < 2; ++lever) {
-        ref_options o = ref_default_options();
-        o.lever = lever;
         ref_sim s;
-        ref_sim_init_table_a1(&s, &o);
-        s.n = 1;
+        double h_eq;
+        const double v0 = 1.0;
+        single_on_floor(&s, lever, v0, 0.0, &h_eq);
         s.wall[0].kr = 0.0;
         s.wall[0].mu_r = 0.0;
         const double m = s.m[0], R = s.R[0], I = s.I[0];
-        const double h_eq = m * 9.81 / s.wall[0].kn;
-        s.x[0] = rv(0.0, R - h_eq, 0.0);
-        const double v0 = 1.0;
-        s.v[0] = rv(v0, 0.0, 0.0);
-        s.w[0] = rv(0.0, 0.0, 0.0);
         ref_sim_start(&s);
         const double a = lever == REF_LEVER_RADIUS ? R : R - h_eq;
         const double L0 = I * s.w[0].z - m * a * s.v[0].x;
@@ -234,16 +242,11 @@ static void test_rolling_resistance_deceleration(void **state)
 {
     (void)state;
     for (int lever = 0; lever < 2; ++lever) {
-        ref_options o = ref_default_options();
-        o.lever = lever;
         ref_sim s;
-        ref_sim_init_table_a1(&s, &o);
-        s.n = 1;
+        double h_eq;
+        single_on_floor(&s, lever, 1.0, 0.0, &h_eq);
         const double m = s.m[0], R = s.R[0], I = s.I[0], g = 9.81;
-        const double h_eq = m * g / s.wall[0].kn;
         const double a = lever == REF_LEVER_RADIUS ? R : R - h_eq;
-        s.x[0] = rv(0.0, R - h_eq, 0.0);
-        s.v[0] = rv(1.0, 0.0, 0.0);
         s.w[0] = rv(0.0, 0.0, -1.0 / a);
         ref_sim_start(&s);
         // Least-squares slope of v_x(t) over 0.05 s .. 0.5 s (it stops at ~0.7 s).
