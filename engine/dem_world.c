@@ -309,6 +309,27 @@ dem_status dem_world_prepare(dem_world *w)
     return DEM_OK;
 }
 
+dem_status dem_world_adopt_network_dt(dem_world *w)
+{
+    dem_status st = dem_world_prepare(w);
+    if (st != DEM_OK) return st;
+    dem_stability net = dem_stability_current(w);
+    if (!(net.dt_limit > 0) || !isfinite(net.dt_limit)) return DEM_OK; // no contacts: keep the a-priori step
+    if (w->def.dt > 0 && w->def.dt > net.dt_limit && !w->def.allow_unstable_dt) {
+        dem_world_set_error(w, "time step %g s is above the stability limit %g s of the current contacts (%s)",
+                            w->def.dt, net.dt_limit, net.why);
+        return DEM_ERR_UNSTABLE;
+    }
+    w->dt_limit = net.dt_limit;
+    w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * net.dt_limit;
+    snprintf(w->dt_report, sizeof w->dt_report,
+             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = %.4g s); limit of the current contact network, %s: "
+             "%.4g s = %.3f dt_crit",
+             w->dt, w->dt / net.dt_crit, net.dt_crit, net.why, net.dt_limit, net.dt_limit / net.dt_crit);
+    w->forces_valid = 0;
+    return DEM_OK;
+}
+
 // Half kick and drift in one pass; flags granules that left the domain.
 static size_t kick_drift(dem_world *restrict w, int *escaped)
 {

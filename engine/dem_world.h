@@ -121,6 +121,13 @@ int dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params 
 /// the first dem_world_step; call it yourself to see the step chosen.
 dem_status dem_world_prepare(dem_world *w);
 
+/// Re-derive the time step from the stability limit of the world's CURRENT
+/// contact network (dem_stability_current) instead of the a-priori densest
+/// cluster: a settled bed of a wide GSD allows a larger step. The step becomes
+/// dt_safety of that limit (or stays as configured, if it is below it);
+/// returns DEM_ERR_UNSTABLE if a configured step is above it.
+dem_status dem_world_adopt_network_dt(dem_world *w);
+
 /// Advance `steps` time steps. Stops early with a status on a fault (NaN,
 /// escaped granule); the state at the fault is kept for inspection.
 dem_status dem_world_step(dem_world *w, uint64_t steps);

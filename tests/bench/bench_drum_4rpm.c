@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Drum run at Table 3's granule-granule parameters (not a test): fill a periodic
 // slice by bed volume, turn it, and print angle and CSA every 0.1 s with the
-// wall time. Usage: build/tests/bench_drum_4rpm LAMBDA SLICE_DEPTH_M RPM
+// wall time. Usage: build/tests/bench_drum_4rpm LAMBDA SLICE_DEPTH_M RPM [live]
+// (a 5th argument: turn at the step of the settled bed's contact network)
 // (the README's 4 rpm figures: bench_drum_4rpm 4096 0.015 4).
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +20,8 @@ int main(int argc, char **argv)
   double px = 0.25*d.gsd.median_diameter*cbrt(d.lambda);
   exp_drum_measure m; exp_drum_measure_now(w,&d,px,2,&m);
   printf("filled %zu granules, wall %.0f s; at rest angle %.2f csa %.2f; %s\n", dem_world_granules(w).count, now()-t0, m.angle_deg, m.csa_percent, dem_world_dt_report(w));
+  if (argc > 4 && dem_world_adopt_network_dt(w) != DEM_OK) { printf("%s\n", dem_world_error(w)); return 1; }
+  if (argc > 4) printf("adopted: %s\n", dem_world_dt_report(w));
   dem_world_set_wall_spin(w, 0, rpm*2*DEM_PI/60);
   double t_start = dem_world_time(w);
   while (dem_world_time(w) - t_start < 6.0) {
