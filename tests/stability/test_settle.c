@@ -93,6 +93,17 @@ static void settle(const dem_gsd *gsd, const char *label)
     assert_true(d.ke_translational < 1e-7 * peak);
     assert_true(d.max_overlap_ratio < 0.05);        // a resting bed, not a compressed one
     assert_true(d.coordination > 3.0);              // and a dense one
+    // The settled bed's own contact network allows a larger step; at it the
+    // bed must stay at rest (no boiling) for another 0.1 s.
+    assert_int_equal(dem_world_adopt_network_dt(w), DEM_OK);
+    printf("  %s\n", dem_world_dt_report(w));
+    double ke_before = d.ke_translational + d.ke_rotational;
+    assert_int_equal(dem_world_step(w, (uint64_t)(0.1 / dem_world_dt(w))), DEM_OK);
+    dem_diagnostics after = dem_world_diagnose(w);
+    printf("  after 0.1 s at that step: KE %.3e J (was %.3e J), translational %.3e J\n",
+           after.ke_translational + after.ke_rotational, ke_before, after.ke_translational);
+    assert_true(after.ke_translational + after.ke_rotational <= 1.05 * ke_before);
+    assert_true(after.ke_translational < 1e-7 * peak);
     dem_world_destroy(w);
 }
 
