@@ -266,3 +266,74 @@ int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel
     exp_raster_free(img);
     return rc;
 }
+
+exp_drum_run_opts exp_default_drum_run_opts(void)
+{
+    return (exp_drum_run_opts){.rpm = 4, .max_time = 6, .sample_interval = 0.05, .window = 1.0,
+                               .angle_tol_deg = 1.0, .csa_tol_percent = 0.5, .adopt_network_dt = 1};
+}
+
+typedef struct window_stats {
+    double mean_angle, sd_angle, mean_csa, sd_csa, mean_fit;
+} window_stats;
+
+static window_stats stats_of(const exp_drum_measure *m, int from, int to)
+{
+    window_stats s = {0};
+    int n = to - from;
+    for (int k = from; k < to; ++k) s.mean_angle += m[k].angle_deg, s.mean_csa += m[k].csa_percent, s.mean_fit += m[k].angle_fit_sd_m;
+    s.mean_angle /= n, s.mean_csa /= n, s.mean_fit /= n;
+    for (int k = from; k < to; ++k) {
+        s.sd_angle += (m[k].angle_deg - s.mean_angle) * (m[k].angle_deg - s.mean_angle);
+        s.sd_csa += (m[k].csa_percent - s.mean_csa) * (m[k].csa_percent - s.mean_csa);
+    }
+    s.sd_angle = n > 1 ? sqrt(s.sd_angle / (n - 1)) : 0, s.sd_csa = n > 1 ? sqrt(s.sd_csa / (n - 1)) : 0;
+    return s;
+}
+
+// Statistically steady: the means of the last two windows agree within the
+// tolerance plus half their mean spread. A bed that slumps in avalanches
+// saw-tooths by many degrees; its window means then differ by sampling
+// noise of that order, and the criterion must not wait for less. While the
+// bed still turns with the drum the means differ by the turned angle.
+static int is_steady(const exp_drum_measure *m, int count, int per_window, const exp_drum_run_opts *o)
+{
+    if (count < 2 * per_window) return 0;
+    window_stats a = stats_of(m, count - 2 * per_window, count - per_window), b = stats_of(m, count - per_window, count);
+    double angle_tol = o->angle_tol_deg + 0.25 * (a.sd_angle + b.sd_angle);
+    double csa_tol = o->csa_tol_percent + 0.25 * (a.sd_csa + b.sd_csa);
+    return fabs(a.mean_angle - b.mean_angle) <= angle_tol && fabs(a.mean_csa - b.mean_csa) <= csa_tol;
+}
+
+dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
+                           void *ctx, exp_drum_result *out)
+{
+    memset(out, 0, sizeof *out);
+    dem_status st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
+    if (st != DEM_OK) return st;
+    dem_world_set_wall_spin(w, 0, o->rpm * 2.0 * DEM_PI / 60.0);
+    int per_window = (int)(o->window / o->sample_interval + 0.5), cap = (int)(o->max_time / o->sample_interval) + 2;
+    exp_drum_measure *m = malloc((size_t)cap * sizeof *m);
+    if (!m) return DEM_ERR_NOMEM;
+    uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5), steps = 0;
+    double t0 = dem_world_time(w), pixel = face_pixel(d);
+    int count = 0;
+    while (count < cap && dem_world_time(w) - t0 < o->max_time - 0.5 * o->sample_interval && !out->steady) {
+        st = dem_world_step(w, chunk);
+        steps += chunk;
+        if (st != DEM_OK || exp_drum_measure_now(w, d, pixel, d->closing_px, &m[count])) break;
+        count++;
+        out->steady = is_steady(m, count, per_window, o);
+        if (progress) progress("turn", dem_world_time(w) - t0, dem_world_granules(w).count, ctx);
+    }
+    int from = count > per_window ? count - per_window : 0;
+    window_stats s = count ? stats_of(m, from, count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
+    free(m);
+    out->angle_deg = s.mean_angle, out->angle_sd_deg = s.sd_angle;
+    out->csa_percent = s.mean_csa, out->csa_sd_percent = s.sd_csa, out->fit_sd_m = s.mean_fit;
+    out->simulated_time_s = dem_world_time(w) - t0;
+    out->granules = dem_world_granules(w).count;
+    out->particle_steps = (unsigned long long)steps * out->granules;
+    if (st != DEM_OK) out->steady = 0;
+    return st;
+}

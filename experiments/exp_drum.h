@@ -60,3 +60,32 @@ int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel
                          exp_drum_measure *out);
 
 #endif
+
+/// How a rotation run decides it is done.
+typedef struct exp_drum_run_opts {
+    double rpm;
+    double max_time;        ///< s of turning at most (the paper: 6 s)
+    double sample_interval; ///< s between measurements (0.05)
+    double window;          ///< s of the averaging window (1.0)
+    double angle_tol_deg;   ///< steady: window means of the angle agree within this (1.0°) + half their mean sd
+    double csa_tol_percent; ///< ... and of the CSA within this (0.5 %) + half their mean sd
+    int adopt_network_dt;   ///< turn at the settled bed's own network step limit (1)
+} exp_drum_run_opts;
+
+exp_drum_run_opts exp_default_drum_run_opts(void);
+
+/// What a rotation run measured: means and spreads over the last window.
+typedef struct exp_drum_result {
+    double angle_deg, angle_sd_deg, csa_percent, csa_sd_percent;
+    double fit_sd_m;        ///< mean spread of the surface about its fitted line
+    int steady;             ///< 1 if the window criterion held before max_time
+    double simulated_time_s, wall_time_s;
+    unsigned long long particle_steps;
+    size_t granules;
+} exp_drum_result;
+
+/// Turn a filled drum at opts->rpm until statistically steady (two
+/// consecutive windows agree) or max_time; the world is changed. Returns
+/// the engine status; a fault is recorded in the result as not steady.
+dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
+                           void *ctx, exp_drum_result *out);
