@@ -6,4 +6,7 @@
 
 int cal_cmd_simulate(int argc, char **argv);
 
+/// Run a drum experiment config with `--set` overrides; results in `out`.
+int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out);
+
 #endif

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: MIT
+// Drum experiment config: libcyaml schema, overrides, validation.
+#include "exp_drum_config.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "exp_scene.h"
+
+static const cyaml_schema_field_t material_fields[] = {
+    CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, exp_material_yaml, name, 1, 31),
+    CYAML_FIELD_FLOAT("mu_s", CYAML_FLAG_DEFAULT, exp_material_yaml, mu_s),
+    CYAML_FIELD_FLOAT("mu_r", CYAML_FLAG_DEFAULT, exp_material_yaml, mu_r), CYAML_FIELD_END};
+static const cyaml_schema_value_t material_entry = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, exp_material_yaml, material_fields)};
+
+#define REQ_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_DEFAULT, exp_drum_yaml, member)
+#define OPT_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, exp_drum_yaml, member)
+static const cyaml_schema_field_t drum_fields[] = {
+    CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, exp_drum_yaml, experiment, 1, 16),
+    REQ_FLOAT("diameter", diameter), REQ_FLOAT("depth", depth), REQ_FLOAT("fill", fill),
+    CYAML_FIELD_BOOL("periodic", CYAML_FLAG_DEFAULT, exp_drum_yaml, periodic), OPT_FLOAT("slice_depth", slice_depth),
+    REQ_FLOAT("density", density), REQ_FLOAT("median_diameter", median_diameter),
+    REQ_FLOAT("geometric_sd", geometric_sd), REQ_FLOAT("truncation_sigmas", truncation_sigmas),
+    REQ_FLOAT("lambda", lambda), REQ_FLOAT("k_n", k_n), REQ_FLOAT("xi", xi), REQ_FLOAT("mu_s", mu_s),
+    REQ_FLOAT("mu_r", mu_r),
+    CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, damping, 1, 32),
+    CYAML_FIELD_STRING_PTR("wall", CYAML_FLAG_POINTER, exp_drum_yaml, wall, 1, 31),
+    CYAML_FIELD_SEQUENCE("materials", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, materials,
+                         &material_entry, 0, 16),
+    REQ_FLOAT("rpm", rpm), REQ_FLOAT("max_time", max_time), OPT_FLOAT("window", window),
+    OPT_FLOAT("sample_interval", sample_interval), OPT_FLOAT("pixel", pixel),
+    CYAML_FIELD_INT("closing_px", CYAML_FLAG_OPTIONAL, exp_drum_yaml, closing_px),
+    CYAML_FIELD_INT("seed", CYAML_FLAG_OPTIONAL, exp_drum_yaml, seed), CYAML_FIELD_END};
+static const cyaml_schema_value_t drum_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, exp_drum_yaml, drum_fields)};
+
+static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
+
+int exp_is_drum_config(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char line[256];
+    int drum = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (line[0] == '#' || line[0] == '\n') continue;
+        drum = strncmp(line, "experiment: drum", 16) == 0;
+        break;
+    }
+    if (f) fclose(f);
+    return drum;
+}
+
+static int fail(char *err, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, len, fmt, ap);
+    va_end(ap);
+    return 1;
+}
+
+static int parse_number(const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    *out = strtod(text, &end);
+    return errno != 0 || end == text || *end != '\0' || !isfinite(*out);
+}
+
+static char *dup_string(const char *s)
+{
+    char *d = malloc(strlen(s) + 1);
+    if (d) strcpy(d, s);
+    return d;
+}
+
+// One "key=value" override; strings are owned by libcyaml's allocator
+// (plain malloc/free via cyaml_mem), so a replaced string is freed with free.
+static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
+{
+    const char *eq = strchr(set, '=');
+    if (!eq) return fail(err, len, "--set %s: expected key=value", set);
+    char key[32];
+    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
+    const char *value = eq + 1;
+    if (strcmp(key, "wall") == 0) {
+        char *copy = dup_string(value);
+        if (!copy) return fail(err, len, "out of memory");
+        free(y->wall);
+        y->wall = copy;
+        return 0;
+    }
+    struct { const char *name; double *field; } numbers[] = {
+        {"rpm", &y->rpm}, {"mu_s", &y->mu_s}, {"mu_r", &y->mu_r}, {"k_n", &y->k_n}, {"lambda", &y->lambda},
+        {"fill", &y->fill}, {"slice_depth", &y->slice_depth}, {"max_time", &y->max_time}, {"xi", &y->xi}};
+    double v;
+    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
+        if (strcmp(key, numbers[k].name) == 0) {
+            if (parse_number(value, &v)) return fail(err, len, "--set %s: '%s' is not a number", key, value);
+            *numbers[k].field = v;
+            return 0;
+        }
+    if (strcmp(key, "seed") == 0) {
+        if (parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
+            return fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
+        y->seed = (int)v;
+        return 0;
+    }
+    return fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
+                          "slice_depth, max_time)", key);
+}
+
+static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char *name)
+{
+    for (unsigned k = 0; k < y->materials_count; ++k)
+        if (strcmp(y->materials[k].name, name) == 0) return &y->materials[k];
+    return NULL;
+}
+
+static int located(const char *path, const char *field, char *err, size_t len, const char *fmt, ...)
+{
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    int line = exp_yaml_line_of(path, field, 1);
+    if (line > 0) return fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return fail(err, len, "%s: %s: %s", path, field, msg);
+}
+
+int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run_opts *run, char *err, size_t len)
+{
+    *def = exp_default_drum_def();
+    *run = exp_default_drum_run_opts();
+    def->diameter = y->diameter, def->fill = y->fill, def->periodic = y->periodic;
+    def->depth = y->periodic ? y->slice_depth : y->depth;
+    def->lambda = y->lambda, def->density = y->density, def->seed = (uint64_t)y->seed;
+    def->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
+    if (mode < 0) return fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
+    def->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, y->mu_r, (dem_damping_mode)mode};
+    def->wall = def->granule; // "granules": a lining of granules is a granular surface (assumption iii)
+    def->wall.k_n = def->wall.k_s = def->wall.k_r = 2 * y->k_n; // Table 3: springs in series
+    if (strcmp(y->wall, "granules") != 0) {
+        const exp_material_yaml *m = find_material(y, y->wall);
+        if (!m) return fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
+        def->wall.mu_s = m->mu_s, def->wall.mu_r = m->mu_r;
+    }
+    def->end_plate = def->wall;
+    if (y->pixel > 0) def->pixel = y->pixel;
+    if (y->closing_px > 0) def->closing_px = y->closing_px;
+    run->rpm = y->rpm, run->max_time = y->max_time;
+    if (y->window > 0) run->window = y->window;
+    if (y->sample_interval > 0) run->sample_interval = y->sample_interval;
+    return 0;
+}
+
+static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t len)
+{
+    if (strcmp(y->experiment, "drum") != 0) return located(path, "experiment", err, len, "must be drum");
+    if (!(y->rpm >= 0 && y->rpm <= 1000)) return located(path, "rpm", err, len, "%g must be in [0, 1000]", y->rpm);
+    if (!(y->max_time > 0)) return located(path, "max_time", err, len, "%g must be > 0", y->max_time);
+    if (y->periodic && !(y->slice_depth > 0))
+        return located(path, "slice_depth", err, len, "%g must be > 0 for a periodic slice", y->slice_depth);
+    if (!(y->k_n > 0)) return located(path, "k_n", err, len, "%g must be > 0", y->k_n);
+    for (unsigned k = 0; k < y->materials_count; ++k)
+        if (!(y->materials[k].mu_s >= 0) || !(y->materials[k].mu_r >= 0))
+            return located(path, "materials", err, len, "'%s': friction must be >= 0", y->materials[k].name);
+    exp_drum_def def;
+    exp_drum_run_opts run;
+    char msg[300];
+    if (exp_drum_config_defs(y, &def, &run, msg, sizeof msg) || exp_drum_check(&def, msg, sizeof msg)) {
+        char field[48];
+        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
+        const char *leaf = strrchr(field, '.');
+        return located(path, leaf ? leaf + 1 : field, err, len, "%s", msg);
+    }
+    return 0;
+}
+
+exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, char *err, size_t len)
+{
+    exp_drum_yaml *y = NULL;
+    cyaml_err_t e = cyaml_load_file(path, &quiet, &drum_schema, (cyaml_data_t **)&y, NULL);
+    if (e != CYAML_OK) {
+        fail(err, len, "%s: %s (check the keys and value types against configs/drum.yaml)", path, cyaml_strerror(e));
+        return NULL;
+    }
+    for (int k = 0; k < n_sets; ++k)
+        if (apply_set(y, sets[k], err, len)) {
+            exp_drum_config_free(y);
+            return NULL;
+        }
+    if (validate(path, y, err, len)) {
+        exp_drum_config_free(y);
+        return NULL;
+    }
+    return y;
+}
+
+void exp_drum_config_free(exp_drum_yaml *y)
+{
+    if (y) cyaml_free(&quiet, &drum_schema, y, 0);
+}
