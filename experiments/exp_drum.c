@@ -260,6 +260,7 @@ int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel
         exp_angle a;
         rc = rc || exp_raster_surface_angle(img, r, 0.6, &a);
         out->angle_deg = fabs(a.angle_deg);
+        out->angle_signed_deg = a.angle_deg;
         out->angle_fit_sd_m = a.residual_sd;
     }
     free(x), free(y);

@@ -53,7 +53,9 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
 
 /// Measure the drum face: angle of the free surface and occupied CSA.
 typedef struct exp_drum_measure {
-    double angle_deg, angle_fit_sd_m, csa_percent;
+    double angle_deg;        ///< magnitude of the surface angle (the dynamic angle of repose)
+    double angle_signed_deg; ///< counter-clockwise positive, seen along +z
+    double angle_fit_sd_m, csa_percent;
 } exp_drum_measure;
 
 int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px,
