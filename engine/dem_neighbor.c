@@ -228,6 +228,7 @@ int dem_nl_rebuild(dem_world *w)
     size_t *start = realloc(nl->start, (n + 1) * sizeof *start);
     if (!start) return dem_world_set_error(w, "out of memory building the neighbour list");
     nl->start = start;
+    nl->rows = n;
     cell_grid g = {0};
     double cutoff = 2.0 * dem_world_max_radius(w) + w->skin;
     grid_dims(w, cutoff, &g);

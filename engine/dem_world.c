@@ -97,6 +97,50 @@ void dem_world_destroy(dem_world *w)
     free(w);
 }
 
+static void *dup_bytes(const void *src, size_t bytes, int *fail)
+{
+    if (!src || bytes == 0) return NULL;
+    void *d = malloc(bytes);
+    if (!d) *fail = 1;
+    else memcpy(d, src, bytes);
+    return d;
+}
+
+static void clone_list(dem_neighbor_list *dst, const dem_neighbor_list *src, int *fail)
+{
+    *dst = *src;
+    dst->start = dup_bytes(src->start, src->start ? (src->rows + 1) * sizeof *src->start : 0, fail);
+    dst->j = dup_bytes(src->j, src->cap * sizeof *src->j, fail);
+    dst->hist = dup_bytes(src->hist, src->hist_cap * sizeof *src->hist, fail);
+}
+
+dem_world *dem_world_clone(const dem_world *w)
+{
+    dem_world *c = malloc(sizeof *c);
+    if (!c) return NULL;
+    *c = *w;
+    int fail = 0;
+    size_t cap = w->cap, pc = w->pair_cap;
+#define DUP(field, count) c->field = dup_bytes(w->field, (count) * sizeof *w->field, &fail)
+    DUP(pos, cap), DUP(vel, cap), DUP(omg, cap), DUP(frc, cap), DUP(trq, cap), DUP(rad, cap), DUP(mass, cap);
+    DUP(inertia, cap), DUP(inv_mass, cap), DUP(inv_inertia, cap), DUP(id, cap), DUP(pos_at_build, cap);
+    DUP(pair_f, pc), DUP(pair_ti, pc), DUP(pair_tj, pc), DUP(rev_pair, pc);
+    DUP(rev_start, w->rev_start ? w->n + 1 : 0);
+#undef DUP
+    for (int k = 0; k < w->n_walls; ++k) {
+        c->walls[k].def.name = c->walls[k].name;
+        size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
+        c->walls[k].hist = dup_bytes(w->walls[k].hist, (cap ? cap : 1) * hl * sizeof(double), &fail);
+    }
+    clone_list(&c->nl, &w->nl, &fail);
+    clone_list(&c->nl_old, &w->nl_old, &fail);
+    if (fail) {
+        dem_world_destroy(c);
+        return NULL;
+    }
+    return c;
+}
+
 #define GROW(ptr, cap) ((ptr) = realloc_or_keep((ptr), (cap) * sizeof *(ptr), &fail))
 static void *realloc_or_keep(void *p, size_t bytes, int *fail)
 {

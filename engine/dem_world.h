@@ -104,6 +104,9 @@ typedef struct dem_world dem_world;
 /// `err`, if not NULL, receives the message).
 dem_world *dem_world_create(const dem_world_def *def, char *err, size_t err_len);
 void dem_world_destroy(dem_world *w);
+/// A deep copy (granules, walls, contact history, time): a settled bed is
+/// filled once and turned at several speeds. NULL on out-of-memory.
+dem_world *dem_world_clone(const dem_world *w);
 
 /// Add a granule; returns its id, or −1 (message in dem_world_error).
 int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity, dem_vec3 omega, double radius,

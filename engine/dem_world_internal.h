@@ -20,6 +20,7 @@ typedef struct dem_neighbor_list {
     double *hist;    // hist_len doubles per pair
     size_t count, cap;
     size_t hist_cap; // doubles allocated in hist
+    size_t rows;     // granules the list was built for (start has rows + 1)
     int hist_len;
 } dem_neighbor_list;
 
