@@ -6,7 +6,8 @@
 
 int cal_cmd_simulate(int argc, char **argv);
 
-/// Run a drum experiment config with `--set` overrides; results in `out`.
-int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out);
+/// Run a drum experiment config with `--set` overrides, at the config's rpm or
+/// at each of `rpm_list` ("4,40,80") from one settled bed; results in `out`.
+int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list);
 
 #endif

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `granucal simulate drum.yaml`: fill, turn to a steady state, measure.
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -42,7 +43,7 @@ static void write_json(FILE *f, const exp_drum_yaml *y, const exp_drum_result *r
 static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *r, const dem_world *w,
                 const char *status)
 {
-    char path[1100], err[1024];
+    char path[1200], err[1024];
     snprintf(path, sizeof path, "%s/result.h5", dir);
     dem_h5_writer *h5 = dem_h5_open(path, err, sizeof err);
     dem_granules_view g = dem_world_granules(w);
@@ -60,29 +61,74 @@ static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *
     return bad;
 }
 
-int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out)
+static int parse_rpm_list(const char *list, double *rpm, int cap, char *err, size_t len)
+{
+    int n = 0;
+    const char *p = list;
+    while (*p && n < cap) {
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || !(v >= 0 && v <= 1000) || (*end && *end != ','))
+            return snprintf(err, len, "--rpm-list '%s': expected numbers in [0, 1000] separated by commas", list), -1;
+        rpm[n++] = v;
+        p = *end ? end + 1 : end;
+    }
+    return n;
+}
+
+// Turn one copy of the settled bed at `rpm`; results in DIR (a sweep: in
+// DIR/rpm_<rpm>/).
+static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def *def, exp_drum_run_opts run, double rpm,
+                     const char *dir, int sweep, progress_state *p, FILE *json_out, int first)
+{
+    char sub[1100], err[1024];
+    if (sweep) snprintf(sub, sizeof sub, "%s/rpm_%g", dir, rpm);
+    else snprintf(sub, sizeof sub, "%s", dir);
+    dem_world *w = dem_world_clone(bed);
+    if (!w || cal_mkdirs(sub, err, sizeof err)) {
+        fprintf(stderr, "granucal simulate: %s\n", w ? err : "out of memory copying the bed");
+        dem_world_destroy(w);
+        return 1;
+    }
+    run.rpm = y->rpm = rpm;
+    double t0 = cal_wall_seconds();
+    exp_drum_result r;
+    dem_status st = exp_drum_rotate(w, def, &run, show_progress, p, &r);
+    r.wall_time_s = cal_wall_seconds() - t0;
+    if (p->tty) fputc('\n', stderr);
+    const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
+    if (st != DEM_OK) fprintf(stderr, "granucal simulate: %g rpm: %s\n", rpm, dem_world_error(w));
+    int bad = save(sub, y, &r, w, status);
+    if (!first) fputs(", ", json_out);
+    write_json(json_out, y, &r, w, status);
+    dem_world_destroy(w);
+    return bad || st != DEM_OK;
+}
+
+int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list)
 {
     char err[1024], dir[1024];
+    double rpms[32];
     exp_drum_yaml *y = exp_drum_config_load(path, n_sets, sets, err, sizeof err);
     if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    int n_rpm = rpm_list ? parse_rpm_list(rpm_list, rpms, 32, err, sizeof err) : 0;
+    if (n_rpm < 0) return fprintf(stderr, "granucal simulate: %s\n", err), exp_drum_config_free(y), 2;
+    if (n_rpm == 0) rpms[n_rpm++] = y->rpm;
     exp_drum_def def;
     exp_drum_run_opts run;
     exp_drum_config_defs(y, &def, &run, err, sizeof err);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/drum");
     if (cal_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), exp_drum_config_free(y), 1;
     progress_state p = {isatty(2), 0, cal_wall_seconds()};
-    dem_world *w = exp_drum_fill(&def, show_progress, &p, err, sizeof err);
-    if (!w) return fprintf(stderr, "\ngranucal simulate: %s\n", err), exp_drum_config_free(y), 1;
-    exp_drum_result r;
-    dem_status st = exp_drum_rotate(w, &def, &run, show_progress, &p, &r);
-    r.wall_time_s = cal_wall_seconds() - p.start;
-    if (p.tty) fputc('\n', stderr);
-    const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
-    if (st != DEM_OK) fprintf(stderr, "granucal simulate: %s\n", dem_world_error(w));
-    fprintf(stderr, "granucal simulate: %s\n", dem_world_dt_report(w));
-    int bad = save(dir, y, &r, w, status);
-    write_json(stdout, y, &r, w, status);
-    dem_world_destroy(w);
+    dem_world *bed = exp_drum_fill(&def, show_progress, &p, err, sizeof err);
+    if (!bed) return fprintf(stderr, "\ngranucal simulate: %s\n", err), exp_drum_config_free(y), 1;
+    fprintf(stderr, "%sgranucal simulate: bed of %zu granules settled after %.2f s; %s\n", p.tty ? "\n" : "",
+            dem_world_granules(bed).count, dem_world_time(bed), dem_world_dt_report(bed));
+    int bad = 0;
+    if (n_rpm > 1) fputs("{\"experiment\": \"drum speed sweep\", \"runs\": [", stdout);
+    for (int k = 0; k < n_rpm; ++k) bad |= turn_copy(bed, y, &def, run, rpms[k], dir, n_rpm > 1, &p, stdout, k == 0);
+    if (n_rpm > 1) fputs("]}\n", stdout);
+    dem_world_destroy(bed);
     exp_drum_config_free(y);
-    return bad || st != DEM_OK ? 1 : 0;
+    return bad;
 }

@@ -13,7 +13,7 @@
 #include "exp_scene.h"
 
 static const char simulate_help[] =
-    "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--out DIR]\n"
+    "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"
     "\n"
     "A drum experiment (a file that starts `experiment: drum`, e.g. configs/drum.yaml):\n"
     "fills the drum by bed volume, turns it until the angle and the occupied area are\n"
@@ -21,8 +21,11 @@ static const char simulate_help[] =
     "csa_percent, their spreads, steady, simulated_time_s, wall_time_s, granules and\n"
     "particle_steps; DIR (default results/runs/drum) gets result.json and result.h5.\n"
     "--set overrides a field: rpm, mu_s, mu_r, k_n, xi, wall (granules or a material),\n"
-    "lambda, seed, fill, slice_depth, max_time. Example:\n"
+    "lambda, seed, fill, slice_depth, max_time. --rpm-list 4,40,80,105,116 turns one\n"
+    "settled bed at each speed (results in DIR/rpm_<speed>/, one JSON with \"runs\").\n"
+    "Examples:\n"
     "  granucal simulate configs/drum.yaml --set rpm=40 --set wall=PTFE\n"
+    "  granucal simulate configs/drum.yaml --rpm-list 4,40,80,105,116\n"
     "\n"
     "An explicit scene (granules and walls listed one by one) writes, in DIR\n"
     "(default results/runs/<scene name>):\n"
@@ -135,18 +138,20 @@ static int finish(const char *dir, sim_outputs *o, const exp_scene *s, dem_world
 int cal_cmd_simulate(int argc, char **argv)
 {
     static const struct option opts[] = {{"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'},
+                                         {"rpm-list", required_argument, 0, 'r'},
                                          {"help", no_argument, 0, 'h'}, {0}};
-    const char *out = NULL;
+    const char *out = NULL, *rpm_list = NULL;
     char *sets[64];
     int n_sets = 0, c;
     while ((c = getopt_long(argc, argv, "o:s:h", opts, NULL)) != -1) {
         if (c == 'h') return fputs(simulate_help, stdout), 0;
         if (c == 'o') out = optarg;
         else if (c == 's' && n_sets < 64) sets[n_sets++] = optarg;
+        else if (c == 'r') rpm_list = optarg;
         else return fputs(simulate_help, stderr), 2;
     }
     if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
-    if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out);
+    if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out, rpm_list);
     if (n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
     char err[1024], dir[1024];
     exp_scene *s = exp_scene_load(argv[optind], err, sizeof err);
