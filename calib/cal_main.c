@@ -14,7 +14,9 @@ static const char main_help[] =
     "\n"
     "commands:\n"
     "  simulate SCENE.yaml   run one scene file (e.g. the paper's verification test,\n"
-    "                        configs/scenes/verification_two_particles.yaml)\n"
+    "                        configs/scenes/verification_two_particles.yaml) or a\n"
+    "                        drum experiment (configs/drum.yaml)\n"
+    "  measure PHOTO.png     angle of repose and occupied area of a drum photograph\n"
     "  --version             print the version\n"
     "\n"
     "Run `granucal COMMAND --help` for the options of a command.\n";
@@ -24,7 +26,7 @@ typedef struct command {
     int (*run)(int argc, char **argv);
 } command;
 
-static const command commands[] = {{"simulate", cal_cmd_simulate}};
+static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}};
 
 int main(int argc, char **argv)
 {
