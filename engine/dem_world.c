@@ -317,6 +317,28 @@ static int check_periodic_length(dem_world *w)
     return 0;
 }
 
+// Check a configured step against a stability limit, or choose the step as
+// dt_safety of it; record the limit and say how the step was found.
+static dem_status apply_limit(dem_world *w, const dem_stability *st, const char *source)
+{
+    if (w->def.dt > 0 && w->def.dt > st->dt_limit && !w->def.allow_unstable_dt) {
+        dem_world_set_error(w,
+                            "time step %g s (%.3f of dt_crit = sqrt(m_min/k_n) = %g s, eq. 14) is above the "
+                            "%s stability limit %g s (%.3f of dt_crit): %s. Use a step <= %g s or leave dt unset.",
+                            w->def.dt, w->def.dt / st->dt_crit, st->dt_crit, source, st->dt_limit,
+                            st->dt_limit / st->dt_crit, st->why, st->dt_limit);
+        return DEM_ERR_UNSTABLE;
+    }
+    w->dt_limit = st->dt_limit;
+    w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * st->dt_limit;
+    snprintf(w->dt_report, sizeof w->dt_report,
+             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = sqrt(m_min/k_n) = %.4g s; the paper uses 0.6); %s limit "
+             "from the %s: %.4g s = %.3f dt_crit%s",
+             w->dt, w->dt / st->dt_crit, st->dt_crit, source, st->why, st->dt_limit, st->dt_limit / st->dt_crit,
+             w->def.dt > 0 ? " (step as configured)" : "; step chosen at dt_safety of it");
+    return DEM_OK;
+}
+
 dem_status dem_world_prepare(dem_world *w)
 {
     if (w->prepared) return DEM_OK;
@@ -331,21 +353,8 @@ dem_status dem_world_prepare(dem_world *w)
         return DEM_OK;
     }
     dem_stability st = dem_stability_apriori(w);
-    if (w->def.dt > 0 && w->def.dt > st.dt_limit && !w->def.allow_unstable_dt) {
-        dem_world_set_error(w,
-                            "time step %g s (%.3f of dt_crit = sqrt(m_min/k_n) = %g s, eq. 14) is above the "
-                            "stability limit %g s (%.3f of dt_crit): %s. Use a step <= %g s or leave dt unset.",
-                            w->def.dt, w->def.dt / st.dt_crit, st.dt_crit, st.dt_limit, st.dt_limit / st.dt_crit,
-                            st.why, st.dt_limit);
-        return DEM_ERR_UNSTABLE;
-    }
-    w->dt_limit = st.dt_limit;
-    w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * st.dt_limit;
-    snprintf(w->dt_report, sizeof w->dt_report,
-             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = sqrt(m_min/k_n) = %.4g s; the paper uses 0.6); "
-             "%s: stability limit %.4g s = %.3f dt_crit%s",
-             w->dt, w->dt / st.dt_crit, st.dt_crit, st.why, st.dt_limit, st.dt_limit / st.dt_crit,
-             w->def.dt > 0 ? " (step as configured)" : "; step chosen at dt_safety of it");
+    dem_status status = apply_limit(w, &st, "a priori");
+    if (status != DEM_OK) return status;
     w->prepared = 1;
     w->forces_valid = 0;
     // Build the list now so diagnostics before the first step see contacts.
@@ -359,17 +368,8 @@ dem_status dem_world_adopt_network_dt(dem_world *w)
     if (st != DEM_OK) return st;
     dem_stability net = dem_stability_current(w);
     if (!(net.dt_limit > 0) || !isfinite(net.dt_limit)) return DEM_OK; // no contacts: keep the a-priori step
-    if (w->def.dt > 0 && w->def.dt > net.dt_limit && !w->def.allow_unstable_dt) {
-        dem_world_set_error(w, "time step %g s is above the stability limit %g s of the current contacts (%s)",
-                            w->def.dt, net.dt_limit, net.why);
-        return DEM_ERR_UNSTABLE;
-    }
-    w->dt_limit = net.dt_limit;
-    w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * net.dt_limit;
-    snprintf(w->dt_report, sizeof w->dt_report,
-             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = %.4g s); limit of the current contact network, %s: "
-             "%.4g s = %.3f dt_crit",
-             w->dt, w->dt / net.dt_crit, net.dt_crit, net.why, net.dt_limit, net.dt_limit / net.dt_crit);
+    st = apply_limit(w, &net, "current contact network");
+    if (st != DEM_OK) return st;
     w->forces_valid = 0;
     return DEM_OK;
 }

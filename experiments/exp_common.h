@@ -4,7 +4,13 @@
 #ifndef EXP_COMMON_H
 #define EXP_COMMON_H
 
+#include <stddef.h>
+
 /// Version string of the experiments layer (part of every result hash).
 const char *exp_version(void);
+
+/// Format a message into err (printf-style) and return 1: the error path of
+/// every loader and builder here.
+int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 #endif

@@ -3,6 +3,8 @@
 #include "exp_drum_config.h"
 
 #include <cyaml/cyaml.h>
+
+#include "exp_common.h"
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -54,15 +56,6 @@ int exp_is_drum_config(const char *path)
     return drum;
 }
 
-static int fail(char *err, size_t len, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, len, fmt, ap);
-    va_end(ap);
-    return 1;
-}
-
 static int parse_number(const char *text, double *out)
 {
     char *end;
@@ -83,13 +76,13 @@ static char *dup_string(const char *s)
 static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
 {
     const char *eq = strchr(set, '=');
-    if (!eq) return fail(err, len, "--set %s: expected key=value", set);
+    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
     char key[32];
     snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
     const char *value = eq + 1;
     if (strcmp(key, "wall") == 0) {
         char *copy = dup_string(value);
-        if (!copy) return fail(err, len, "out of memory");
+        if (!copy) return exp_fail(err, len, "out of memory");
         free(y->wall);
         y->wall = copy;
         return 0;
@@ -100,17 +93,17 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
     double v;
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (strcmp(key, numbers[k].name) == 0) {
-            if (parse_number(value, &v)) return fail(err, len, "--set %s: '%s' is not a number", key, value);
+            if (parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
             *numbers[k].field = v;
             return 0;
         }
     if (strcmp(key, "seed") == 0) {
         if (parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
-            return fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
+            return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
         y->seed = (int)v;
         return 0;
     }
-    return fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
+    return exp_fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
                           "slice_depth, max_time)", key);
 }
 
@@ -129,8 +122,8 @@ static int located(const char *path, const char *field, char *err, size_t len, c
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     int line = exp_yaml_line_of(path, field, 1);
-    if (line > 0) return fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
-    return fail(err, len, "%s: %s: %s", path, field, msg);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
 }
 
 int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run_opts *run, char *err, size_t len)
@@ -142,13 +135,13 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     def->lambda = y->lambda, def->density = y->density, def->seed = (uint64_t)y->seed;
     def->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
     int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
-    if (mode < 0) return fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
+    if (mode < 0) return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
     def->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, y->mu_r, (dem_damping_mode)mode};
     def->wall = def->granule; // "granules": a lining of granules is a granular surface (assumption iii)
     def->wall.k_n = def->wall.k_s = def->wall.k_r = 2 * y->k_n; // Table 3: springs in series
     if (strcmp(y->wall, "granules") != 0) {
         const exp_material_yaml *m = find_material(y, y->wall);
-        if (!m) return fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
+        if (!m) return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
         def->wall.mu_s = m->mu_s, def->wall.mu_r = m->mu_r;
     }
     def->end_plate = def->wall;
@@ -188,7 +181,7 @@ exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, c
     exp_drum_yaml *y = NULL;
     cyaml_err_t e = cyaml_load_file(path, &quiet, &drum_schema, (cyaml_data_t **)&y, NULL);
     if (e != CYAML_OK) {
-        fail(err, len, "%s: %s (check the keys and value types against configs/drum.yaml)", path, cyaml_strerror(e));
+        exp_fail(err, len, "%s: %s (check the keys and value types against configs/drum.yaml)", path, cyaml_strerror(e));
         return NULL;
     }
     for (int k = 0; k < n_sets; ++k)

@@ -3,6 +3,8 @@
 #include "exp_scene.h"
 
 #include <cyaml/cyaml.h>
+
+#include "exp_common.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -104,15 +106,6 @@ int exp_yaml_line_of(const char *path, const char *key, int from_line)
     return found;
 }
 
-static int fail(char *err, size_t len, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, len, fmt, ap);
-    va_end(ap);
-    return 1;
-}
-
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len)
 {
@@ -120,12 +113,12 @@ int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, co
     if (y->damping) {
         int m = dem_damping_mode_from_name(y->damping);
         if (m < 0)
-            return fail(err, err_len, "%s.damping = '%s': unknown; use approaching, always, separating or no_tension",
+            return exp_fail(err, err_len, "%s.damping = '%s': unknown; use approaching, always, separating or no_tension",
                         where, y->damping);
         out->damping = (dem_damping_mode)m;
     }
     char sub[256];
-    if (dem_contact_params_check(out, sub, sizeof sub)) return fail(err, err_len, "%s.%s", where, sub);
+    if (dem_contact_params_check(out, sub, sizeof sub)) return exp_fail(err, err_len, "%s.%s", where, sub);
     return 0;
 }
 
@@ -140,8 +133,8 @@ static int located(const char *path, const char *msg, char *err, size_t len)
     const char *leaf = strrchr(field, '.');
     leaf = leaf ? leaf + 1 : field;
     int line = exp_yaml_line_of(path, leaf, 1);
-    if (line > 0) return fail(err, len, "%s:%d: %s", path, line, msg);
-    return fail(err, len, "%s: %s", path, msg);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s", path, line, msg);
+    return exp_fail(err, len, "%s: %s", path, msg);
 }
 
 static int check_positive(const char *path, const char *field, double v, char *err, size_t len)
@@ -185,7 +178,7 @@ exp_scene *exp_scene_load(const char *path, char *err, size_t err_len)
     exp_scene *s = NULL;
     cyaml_err_t e = cyaml_load_file(path, config_for(&log), &scene_schema, (cyaml_data_t **)&s, NULL);
     if (e != CYAML_OK) {
-        fail(err, err_len, "%s: %s%s%s", path, cyaml_strerror(e), log.used ? ": " : "", log.text);
+        exp_fail(err, err_len, "%s: %s%s%s", path, cyaml_strerror(e), log.used ? ": " : "", log.text);
         return NULL;
     }
     if (validate(path, s, err, err_len)) {
@@ -217,7 +210,7 @@ static int add_walls(const exp_scene *s, dem_world *w, char *err, size_t len)
         const exp_wall_yaml *y = &s->walls[k];
         dem_wall_def d = {0};
         int kind = wall_kind_from_name(y->kind);
-        if (kind < 0) return fail(err, len, "walls[%u].kind = '%s': use plane, disc or cylinder", k, y->kind);
+        if (kind < 0) return exp_fail(err, len, "walls[%u].kind = '%s': use plane, disc or cylinder", k, y->kind);
         d.kind = (dem_wall_kind)kind;
         d.point = v3(y->point), d.normal = v3(y->normal), d.axis = v3(y->axis);
         d.radius = y->radius;
@@ -226,7 +219,7 @@ static int add_walls(const exp_scene *s, dem_world *w, char *err, size_t len)
         char where[32];
         snprintf(where, sizeof where, "walls[%u].contact", k);
         if (exp_contact_from_yaml(&y->contact, &d.contact, where, err, len)) return 1;
-        if (dem_world_add_wall(w, &d) < 0) return fail(err, len, "walls[%u]: %s", k, dem_world_error(w));
+        if (dem_world_add_wall(w, &d) < 0) return exp_fail(err, len, "walls[%u]: %s", k, dem_world_error(w));
     }
     return 0;
 }
@@ -248,7 +241,7 @@ dem_world *exp_scene_build(const exp_scene *s, char *err, size_t err_len)
     for (unsigned k = 0; k < s->granules_count; ++k) {
         const exp_granule_yaml *g = &s->granules[k];
         if (dem_world_add_granule(w, v3(g->position), v3(g->velocity), v3(g->omega), g->radius, g->density) < 0) {
-            fail(err, err_len, "granules[%u]: %s", k, dem_world_error(w));
+            exp_fail(err, err_len, "granules[%u]: %s", k, dem_world_error(w));
             dem_world_destroy(w);
             return NULL;
         }
