@@ -9,6 +9,9 @@
 /// Version string of the experiments layer (part of every result hash).
 const char *exp_version(void);
 
+/// Progress callback of long phases: phase name, simulated time, granules.
+typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);
+
 /// Format a message into err (printf-style) and return 1: the error path of
 /// every loader and builder here.
 int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "dem_scaling.h"
+#include "exp_pour.h"
 
 #define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
 #define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE over (bed mass)·g·d50
@@ -81,91 +82,20 @@ static dem_world *create_drum(const exp_drum_def *d, char *err, size_t len)
     return w;
 }
 
-static int cmp_double(const void *a, const void *b)
+// The drum's cross-section, less half a pitch, is where a layer may go.
+static int inside_drum(dem_vec3 p, const void *ctx)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    double inner = *(const double *)ctx;
+    return p.x * p.x + p.y * p.y <= inner * inner;
 }
 
-// Height below which 98 % of the granule tops lie: the bed's surface,
-// ignoring the few granules still bouncing above it.
-static double bed_surface(const dem_world *w, double drum_r)
-{
-    dem_granules_view g = dem_world_granules(w);
-    if (g.count == 0) return -drum_r;
-    double *tops = malloc(g.count * sizeof *tops);
-    if (!tops) return drum_r;
-    for (size_t i = 0; i < g.count; ++i) tops[i] = g.position[i].y + g.radius[i];
-    qsort(tops, g.count, sizeof *tops, cmp_double);
-    double top = tops[(size_t)(0.98 * (double)(g.count - 1))];
-    free(tops);
-    return top;
-}
-
-// Does a granule of radius r at p overlap any granule above height `above`?
-static int overlaps(const dem_world *w, dem_vec3 p, double r, double above)
-{
-    dem_granules_view g = dem_world_granules(w);
-    for (size_t i = 0; i < g.count; ++i) {
-        if (g.position[i].y + g.radius[i] < above) continue;
-        double reach = r + g.radius[i];
-        if (dem_v3_norm2(dem_v3_sub(g.position[i], p)) < reach * reach) return 1;
-    }
-    return 0;
-}
-
-// Place granules [next, n) on a lattice of pitch d_max in the free part of
-// the drum above the bed; returns how many were placed.
 static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *diam, size_t next, size_t n, double pitch)
 {
-    double r = 0.5 * d->diameter, y0 = bed_surface(w, r) + 0.5 * pitch, inner = r - 0.55 * pitch;
-    double z0 = d->periodic ? 0.5 * pitch : 0.6 * pitch, z1 = d->depth - (d->periodic ? 0.5 * pitch : 0.6 * pitch);
-    double rho = dem_scale_density(d->density, d->lambda);
-    size_t placed = 0;
-    for (double y = y0; y < inner && next + placed < n; y += pitch)
-        for (double x = -inner; x <= inner && next + placed < n; x += pitch)
-            for (double z = z0; z <= z1 + 1e-12 && next + placed < n; z += pitch) {
-                size_t k = next + placed;
-                dem_vec3 p = dem_v3(x, y, z);
-                if (x * x + y * y > inner * inner || overlaps(w, p, 0.5 * diam[k], y0 - pitch)) continue;
-                dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0);
-                if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], rho) < 0) return placed;
-                placed++;
-            }
-    return placed;
-}
-
-static int run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
-{
-    uint64_t chunk = (uint64_t)(0.01 / dem_world_dt(w)) + 1;
-    double t_end = dem_world_time(w) + seconds;
-    while (dem_world_time(w) < t_end) {
-        if (dem_world_step(w, chunk) != DEM_OK) return 1;
-        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
-    }
-    return 0;
-}
-
-// Kinetic energy over (bed mass)·g·d50: the bed is at rest when small.
-static double ke_ratio(const dem_world *w, double d50)
-{
-    dem_granules_view g = dem_world_granules(w);
-    double mass = 0;
-    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
-    dem_diagnostics d = dem_world_diagnose(w);
-    return g.count ? (d.ke_translational + d.ke_rotational) / (mass * 9.81 * d50) : 0.0;
-}
-
-// Run in 0.05 s chunks until the KE ratio falls below `ratio` or `max_time`
-// has passed; non-zero on an engine fault.
-static int run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress,
-                          void *ctx, const char *phase)
-{
-    for (double t = 0; t < max_time; t += 0.05) {
-        if (run_for(w, 0.05, progress, ctx, phase)) return 1;
-        if (ke_ratio(w, d50) < ratio) break;
-    }
-    return 0;
+    double r = 0.5 * d->diameter, inner = r - 0.55 * pitch;
+    double margin = d->periodic ? 0.5 * pitch : 0.6 * pitch;
+    exp_pour_region region = {dem_v3(-inner, -r, margin), dem_v3(inner, inner, d->depth - margin + 1e-12), inside_drum,
+                              &inner};
+    return exp_pour_layer(w, &region, -r, diam, next, n, pitch, dem_scale_density(d->density, d->lambda));
 }
 
 // Raster resolution of the drum face: a quarter of the median diameter, and
@@ -232,13 +162,13 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
         size_t placed = next < cap ? place_layer(w, d, diam, next, cap, pitch) : 0;
         if (placed == 0) return fill_failed(w, diam, err, len, "no room left to pour: the fill degree is too high");
         if (dem_world_prepare(w) != DEM_OK ||
-            run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
+            exp_run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
             return fill_failed(w, diam, err, len, NULL);
         next += placed;
     }
     free(diam);
     cut_to_fill(w, d);
-    if (run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle"))
+    if (exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle"))
         return fill_failed(w, NULL, err, len, NULL);
     return w;
 }

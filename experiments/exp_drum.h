@@ -11,6 +11,7 @@
 
 #include "dem_gsd.h"
 #include "dem_world.h"
+#include "exp_common.h"
 #include "exp_measure.h"
 
 /// Definition of a drum run. Powder and contacts are given for the REAL
@@ -39,8 +40,6 @@ exp_drum_def exp_default_drum_def(void);
 /// Check a definition; a message names the field.
 int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);
 
-/// Progress callback: phase name, simulated time, granules; may be NULL.
-typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);
 
 /// Build the drum and fill it as the lab does, by bed volume: granules are
 /// poured in layers into the empty upper part of the drum, each layer

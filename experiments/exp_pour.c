@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+#include "exp_pour.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double exp_bed_surface(const dem_world *w, double floor_y)
+{
+    dem_granules_view g = dem_world_granules(w);
+    if (g.count == 0) return floor_y;
+    double *tops = malloc(g.count * sizeof *tops);
+    if (!tops) return INFINITY;
+    for (size_t i = 0; i < g.count; ++i) tops[i] = g.position[i].y + g.radius[i];
+    qsort(tops, g.count, sizeof *tops, cmp_double);
+    double top = tops[(size_t)(0.98 * (double)(g.count - 1))];
+    free(tops);
+    return top;
+}
+
+// Does a granule of radius r at p overlap any granule reaching above `above`?
+static int overlaps(const dem_world *w, dem_vec3 p, double r, double above)
+{
+    dem_granules_view g = dem_world_granules(w);
+    for (size_t i = 0; i < g.count; ++i) {
+        if (g.position[i].y + g.radius[i] < above) continue;
+        double reach = r + g.radius[i];
+        if (dem_v3_norm2(dem_v3_sub(g.position[i], p)) < reach * reach) return 1;
+    }
+    return 0;
+}
+
+size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_y, const double *diam, size_t next,
+                      size_t n, double pitch, double density)
+{
+    double y0 = exp_bed_surface(w, floor_y) + 0.5 * pitch;
+    size_t placed = 0;
+    for (double y = y0; y < region->hi.y && next + placed < n; y += pitch)
+        for (double x = region->lo.x; x <= region->hi.x && next + placed < n; x += pitch)
+            for (double z = region->lo.z; z <= region->hi.z && next + placed < n; z += pitch) {
+                size_t k = next + placed;
+                dem_vec3 p = dem_v3(x, y, z);
+                if (!region->inside(p, region->ctx) || overlaps(w, p, 0.5 * diam[k], y0 - pitch)) continue;
+                // A small sideways velocity so layers do not stack in columns.
+                dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0);
+                if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], density) < 0) return placed;
+                placed++;
+            }
+    return placed;
+}
+
+int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
+{
+    uint64_t chunk = (uint64_t)(0.01 / dem_world_dt(w)) + 1;
+    double t_end = dem_world_time(w) + seconds;
+    while (dem_world_time(w) < t_end) {
+        if (dem_world_step(w, chunk) != DEM_OK) return 1;
+        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
+    }
+    return 0;
+}
+
+double exp_ke_ratio(const dem_world *w, double d50)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double mass = 0;
+    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
+    dem_diagnostics d = dem_world_diagnose(w);
+    return g.count ? (d.ke_translational + d.ke_rotational) / (mass * 9.81 * d50) : 0.0;
+}
+
+int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
+                       const char *phase)
+{
+    for (double t = 0; t < max_time; t += 0.05) {
+        if (exp_run_for(w, 0.05, progress, ctx, phase)) return 1;
+        if (exp_ke_ratio(w, d50) < ratio) break;
+    }
+    return 0;
+}

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+/// @file exp_pour.h
+/// Pouring granules into a container, shared by the drum and the poured
+/// cylinder: layers of granules on a lattice in the empty space above the
+/// bed, each layer landing before the next; and running until at rest.
+#ifndef EXP_POUR_H
+#define EXP_POUR_H
+
+#include <stddef.h>
+
+#include "dem_world.h"
+#include "exp_common.h"
+
+/// Where a poured layer may go: the lattice spans [lo, hi] (y up), and a
+/// lattice point is used if `inside` says it lies in the container.
+typedef struct exp_pour_region {
+    dem_vec3 lo, hi;
+    int (*inside)(dem_vec3 p, const void *ctx);
+    const void *ctx;
+} exp_pour_region;
+
+/// Height below which 98 % of the granule tops lie (the bed surface,
+/// ignoring a few bouncing granules); `floor_y` for an empty world.
+double exp_bed_surface(const dem_world *w, double floor_y);
+
+/// Place granules next.. of `diam` (diameters) on a lattice of `pitch` from
+/// half a pitch above the bed surface up to region->hi.y, skipping points
+/// outside the region or overlapping a granule already there. Returns how
+/// many were placed (0: no room).
+size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_y, const double *diam, size_t next,
+                      size_t n, double pitch, double density);
+
+/// Kinetic energy over (bed mass)·g·d50: the bed is at rest when small.
+double exp_ke_ratio(const dem_world *w, double d50);
+
+/// Run `seconds`, reporting progress every 0.01 s; non-zero on a fault.
+int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase);
+
+/// Run in 0.05 s chunks until exp_ke_ratio < ratio or max_time; non-zero on
+/// an engine fault.
+int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
+                       const char *phase);
+
+#endif
