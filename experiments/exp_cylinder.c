@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: MIT
+// The poured cylinder (section 4.1): pour, cut at the rim, settle, count.
+#include "exp_cylinder.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_scaling.h"
+#include "exp_pour.h"
+
+#define LAYER_KE_RATIO 1e-2
+#define LAYER_MAX_TIME 0.6
+#define SETTLE_KE_RATIO 1e-6
+#define SETTLE_MAX_TIME 2.0
+
+exp_cylinder_def exp_default_cylinder_def(void)
+{
+    exp_cylinder_def d;
+    memset(&d, 0, sizeof d);
+    d.diameter = 0.1;
+    d.depth = 0.04;
+    d.lambda = 4096;
+    d.gsd = dem_default_gsd();
+    d.density = 1800;
+    d.granule = dem_default_world_def().granule;
+    d.wall = d.granule; // a metallic container; its friction is the wall material's
+    d.seed = 1;
+    return d;
+}
+
+static dem_world *create_container(const exp_cylinder_def *d, char *err, size_t len)
+{
+    double r = 0.5 * d->diameter;
+    dem_world_def def = dem_default_world_def();
+    def.granule = dem_scale_contact(&d->granule, d->lambda);
+    def.domain_lo = dem_v3(-1.2 * r, -0.01, -1.2 * r);
+    def.domain_hi = dem_v3(1.2 * r, 4 * d->depth, 1.2 * r);
+    dem_world *w = dem_world_create(&def, err, len);
+    if (!w) return NULL;
+    dem_contact_params wall = d->wall;
+    wall.k_n = wall.k_s = wall.k_r = 2 * d->granule.k_n; // Table 3: springs in series
+    wall = dem_scale_contact(&wall, d->lambda);
+    dem_wall_def side = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 1, 0}, .radius = r,
+                         .contact = wall, .name = "container"};
+    dem_wall_def floor = {.kind = DEM_WALL_PLANE, .point = {0, 0, 0}, .normal = {0, 1, 0}, .axis = {0, 1, 0},
+                          .contact = wall, .name = "floor"};
+    if (dem_world_add_wall(w, &side) < 0 || dem_world_add_wall(w, &floor) < 0) {
+        exp_fail(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
+    return w;
+}
+
+static int inside_column(dem_vec3 p, const void *ctx)
+{
+    double inner = *(const double *)ctx;
+    return p.x * p.x + p.z * p.z <= inner * inner;
+}
+
+static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return g->position[i].y <= *(double *)ctx; }
+
+// Pour until the bed surface passes the rim; then keep the granules whose
+// centres lie below it.
+static int pour_to_rim(dem_world *w, const exp_cylinder_def *d, const dem_gsd *gsd, exp_progress_fn progress,
+                       void *ctx, char *err, size_t len)
+{
+    double r = 0.5 * d->diameter, pitch = 1.05 * dem_gsd_max_diameter(gsd), inner = r - 0.55 * pitch;
+    double volume = DEM_PI * r * r * d->depth;
+    size_t cap = 3 * dem_gsd_count_for_volume(gsd, 0.6 * volume) + 16, next = 0;
+    double *diam = malloc(cap * sizeof *diam);
+    if (!diam || dem_gsd_sample(gsd, d->seed, cap, diam)) return free(diam), exp_fail(err, len, "cannot sample sizes");
+    exp_pour_region region = {dem_v3(-inner, 0, -inner), dem_v3(inner, 3 * d->depth, inner), inside_column, &inner};
+    double rho = dem_scale_density(d->density, d->lambda);
+    while (exp_bed_surface(w, 0) < d->depth) {
+        size_t placed = next < cap ? exp_pour_layer(w, &region, 0, diam, next, cap, pitch, rho) : 0;
+        if (placed == 0) return free(diam), exp_fail(err, len, "poured cylinder: ran out of room or sizes");
+        if (dem_world_prepare(w) != DEM_OK ||
+            exp_run_until_rest(w, gsd->median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
+            return free(diam), exp_fail(err, len, "%s", dem_world_error(w));
+        next += placed;
+    }
+    free(diam);
+    double rim = d->depth;
+    dem_world_remove_granules(w, keep_below, &rim);
+    return 0;
+}
+
+// Granule–granule contact count of granule i, from the diagnostics' rule
+// (overlap > 0), by brute force over its neighbours in a sorted sweep.
+static void count_contacts(const dem_world *w, const exp_cylinder_def *d, double dmax, exp_cylinder_result *out)
+{
+    dem_granules_view g = dem_world_granules(w);
+    int *z = calloc(g.count, sizeof *z);
+    if (!z) return;
+    for (size_t i = 0; i < g.count; ++i)
+        for (size_t j = i + 1; j < g.count; ++j) {
+            double reach = g.radius[i] + g.radius[j];
+            if (dem_v3_norm2(dem_v3_sub(g.position[i], g.position[j])) < reach * reach) z[i]++, z[j]++;
+        }
+    double r = 0.5 * d->diameter, top = 0, sum_in = 0, solid = 0;
+    size_t n_in = 0;
+    for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y);
+    for (size_t i = 0; i < g.count; ++i) {
+        dem_vec3 p = g.position[i];
+        solid += 4.0 / 3.0 * DEM_PI * g.radius[i] * g.radius[i] * g.radius[i];
+        int interior = sqrt(p.x * p.x + p.z * p.z) < r - dmax && p.y > dmax && p.y < top - dmax;
+        if (interior) sum_in += z[i], n_in++;
+    }
+    free(z);
+    out->coordination_interior = n_in ? sum_in / (double)n_in : NAN;
+    out->solid_fraction = solid / (DEM_PI * r * r * d->depth);
+}
+
+dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress, void *ctx, exp_cylinder_result *out,
+                            char *err, size_t len)
+{
+    char sub[256];
+    memset(out, 0, sizeof *out);
+    if (len) err[0] = '\0';
+    if (dem_scale_check(d->lambda, sub, sizeof sub) || dem_gsd_check(&d->gsd, sub, sizeof sub) ||
+        dem_contact_params_check(&d->granule, sub, sizeof sub)) {
+        exp_fail(err, len, "poured cylinder: %s", sub);
+        return NULL;
+    }
+    dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
+    dem_world *w = create_container(d, err, len);
+    if (!w) return NULL;
+    if (pour_to_rim(w, d, &gsd, progress, ctx, err, len) ||
+        exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
+        if (!err[0]) exp_fail(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
+    dem_diagnostics diag = dem_world_diagnose(w);
+    out->granules = diag.granules;
+    out->coordination = diag.coordination;
+    out->wall_contacts_per_granule = diag.granules ? (double)diag.wall_contacts / (double)diag.granules : 0;
+    out->simulated_time_s = dem_world_time(w);
+    count_contacts(w, d, dem_gsd_max_diameter(&gsd), out);
+    return w;
+}
