@@ -87,6 +87,7 @@ typedef struct dem_contact_out {
     dem_vec3 f_tangential; ///< F_ij,s on i
     dem_vec3 f_rolling;    ///< rolling quasi-force F_ij,r
     double normal_force;   ///< signed magnitude along −n_ij (> 0 repulsive)
+    double damping_coeff;  ///< γ_n the dashpot applied this step (0 if off, or clamped away)
 } dem_contact_out;
 
 /// Doubles of history a contact needs for the given feature mask.
@@ -157,11 +158,15 @@ static inline void dem_contact_eval(const dem_contact_coeffs *c, const dem_conta
     const double vn = dem_v3_dot(s->vrel, n); // > 0 approaching (eq. 5)
     // Eq. 3: F_n = −k_n h n − γ_n v_rel,n; here fn is its magnitude along −n.
     double fn = c->k_n * s->overlap;
+    out->damping_coeff = 0.0;
     if (features & DEM_FEAT_DAMPING) {
         // Eq. 4: γ_n = 2ξ sqrt(m* k_n), on for the phase(s) the reading selects.
         double on = vn > 0.0 ? c->damp_approaching : c->damp_separating;
-        fn += on * c->two_xi_sqrt_kn * sqrt(s->reduced_mass) * vn;
-        fn = c->clamp_tension != 0.0 && fn < 0.0 ? 0.0 : fn;
+        double gamma = on * c->two_xi_sqrt_kn * sqrt(s->reduced_mass);
+        fn += gamma * vn;
+        int clamped = c->clamp_tension != 0.0 && fn < 0.0;
+        fn = clamped ? 0.0 : fn;
+        out->damping_coeff = clamped ? 0.0 : gamma;
     }
     out->normal_force = fn;
     out->force = dem_v3_scale(n, -fn);

@@ -31,6 +31,7 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
+        w->pair_g[k] = 0.0;
         return;
     }
     const double dist = sqrt(dist2);
@@ -52,6 +53,8 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
     dem_contact_out out;
     dem_contact_eval(&w->gg, &s, hist, &out, mask);
     w->pair_f[k] = out.force;
+    w->pair_g[k] = out.damping_coeff;
+    w->pair_n[k] = n;
     // Eq. 9–10: torques on i and on j.
     const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
     const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
@@ -65,6 +68,13 @@ static inline void pair_loop(dem_world *restrict w, const unsigned mask)
 #pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < n; ++i)
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask);
+}
+
+// Accumulate γ n nᵀ into a symmetric 3×3 stored as xx yy zz xy xz yz.
+static inline void add_damping(double *d, double g, dem_vec3 n)
+{
+    d[0] += g * n.x * n.x, d[1] += g * n.y * n.y, d[2] += g * n.z * n.z;
+    d[3] += g * n.x * n.y, d[4] += g * n.x * n.z, d[5] += g * n.y * n.z;
 }
 
 static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_t i, const unsigned mask)
@@ -94,6 +104,7 @@ static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_
     dem_contact_out out;
     dem_contact_eval(&wall->coeffs, &s, hist, &out, mask);
     w->frc[i] = dem_v3_add(w->frc[i], out.force);
+    if ((mask & DEM_FEAT_DAMPING) && w->def.implicit_damping) add_damping(w->damp + 6 * i, out.damping_coeff, n);
     const dem_vec3 ts = dem_v3_scale(dem_v3_cross(n, out.f_tangential), ai);
     const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), r);
     w->trq[i] = dem_v3_add(w->trq[i], dem_v3_sub(ts, tr));
@@ -157,9 +168,24 @@ static void gather(dem_world *restrict w)
     }
 }
 
+// Each granule's own dashpots, Σγ n nᵀ over its contacts (implicit dashpot).
+static void gather_damping(dem_world *restrict w)
+{
+    const size_t n = w->n;
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+    for (size_t i = 0; i < n; ++i) {
+        double d[6] = {0, 0, 0, 0, 0, 0};
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) add_damping(d, w->pair_g[k], w->pair_n[k]);
+        for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1]; ++r)
+            add_damping(d, w->pair_g[w->rev_pair[r]], w->pair_n[w->rev_pair[r]]);
+        for (int c = 0; c < 6; ++c) w->damp[6 * i + c] = d[c];
+    }
+}
+
 void dem_forces_compute(dem_world *w)
 {
     pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w);
     gather(w);
+    if (w->def.implicit_damping) gather_damping(w);
     for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & 7u](w, &w->walls[k]);
 }

@@ -187,7 +187,11 @@ static int ensure_pairs(dem_world *w, size_t pairs)
         if (tj) w->pair_tj = tj;
         size_t *rp = tj ? realloc(w->rev_pair, cap * sizeof *rp) : NULL;
         if (rp) w->rev_pair = rp;
-        if (!rp) return 1;
+        dem_vec3 *pn = rp ? realloc(w->pair_n, cap * sizeof *pn) : NULL;
+        if (pn) w->pair_n = pn;
+        double *pg = pn ? realloc(w->pair_g, cap * sizeof *pg) : NULL;
+        if (pg) w->pair_g = pg;
+        if (!pg) return 1;
         w->pair_cap = cap;
     }
     return 0;

@@ -12,7 +12,9 @@
 /// springs) and dashpot operators of a contact network gives the highest
 /// angular frequency ω and damping rate c; velocity Verlet with a velocity
 /// lagged by half a step is stable for ω·dt < 2(sqrt(1+ζ²) − ζ), which with
-/// ζ ≤ c/(2ω) gives dt < 4 / (sqrt(4ω² + c²) + c).
+/// ζ ≤ c/(2ω) gives dt < 4 / (sqrt(4ω² + c²) + c). With the implicit dashpot
+/// (dem_world_def.implicit_damping) the limit is that of the springs alone,
+/// ω·dt < 2.
 #ifndef DEM_STABILITY_H
 #define DEM_STABILITY_H
 

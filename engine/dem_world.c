@@ -89,6 +89,7 @@ void dem_world_destroy(dem_world *w)
     if (!w) return;
     void *arrays[] = {w->pos, w->vel, w->omg, w->frc, w->trq, w->rad, w->mass, w->inertia, w->inv_mass,
                       w->inv_inertia, w->id, w->pair_f, w->pair_ti, w->pair_tj, w->rev_start, w->rev_pair,
+                      w->pair_n, w->pair_g, w->damp,
                       w->pos_at_build};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) free(arrays[k]);
     for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist);
@@ -124,7 +125,8 @@ dem_world *dem_world_clone(const dem_world *w)
 #define DUP(field, count) c->field = dup_bytes(w->field, (count) * sizeof *w->field, &fail)
     DUP(pos, cap), DUP(vel, cap), DUP(omg, cap), DUP(frc, cap), DUP(trq, cap), DUP(rad, cap), DUP(mass, cap);
     DUP(inertia, cap), DUP(inv_mass, cap), DUP(inv_inertia, cap), DUP(id, cap), DUP(pos_at_build, cap);
-    DUP(pair_f, pc), DUP(pair_ti, pc), DUP(pair_tj, pc), DUP(rev_pair, pc);
+    DUP(pair_f, pc), DUP(pair_ti, pc), DUP(pair_tj, pc), DUP(rev_pair, pc), DUP(pair_n, pc), DUP(pair_g, pc);
+    DUP(damp, 6 * cap);
     DUP(rev_start, w->rev_start ? w->n + 1 : 0);
 #undef DUP
     for (int k = 0; k < w->n_walls; ++k) {
@@ -157,6 +159,7 @@ static int grow_granules(dem_world *w, size_t need)
     GROW(w->pos, cap), GROW(w->vel, cap), GROW(w->omg, cap), GROW(w->frc, cap), GROW(w->trq, cap);
     GROW(w->rad, cap), GROW(w->mass, cap), GROW(w->inertia, cap), GROW(w->inv_mass, cap);
     GROW(w->inv_inertia, cap), GROW(w->id, cap), GROW(w->pos_at_build, cap);
+    w->damp = realloc_or_keep(w->damp, cap * 6 * sizeof *w->damp, &fail);
     for (int k = 0; k < w->n_walls; ++k) {
         size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
         GROW(w->walls[k].hist, cap * hl);
@@ -374,6 +377,24 @@ dem_status dem_world_adopt_network_dt(dem_world *w)
     return DEM_OK;
 }
 
+// Velocity of granule i after a kick of `h`: v + h·(F/m + g) explicitly, or
+// with the implicit dashpot v + h·(m·I + Δt·D)⁻¹(F + m g), D = Σγ n nᵀ of
+// its contacts (symmetric positive semi-definite: the solve always exists).
+static inline dem_vec3 kicked_velocity(const dem_world *restrict w, size_t i, double h, dem_vec3 g)
+{
+    if (!w->def.implicit_damping) return dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
+    const double *d = w->damp + 6 * i, m = w->mass[i], dt = w->dt;
+    double a = m + dt * d[0], b = m + dt * d[1], c = m + dt * d[2], xy = dt * d[3], xz = dt * d[4], yz = dt * d[5];
+    dem_vec3 f = dem_v3_axpy(m, g, w->frc[i]);
+    // Cramer's rule on the symmetric matrix [[a xy xz] [xy b yz] [xz yz c]].
+    double c00 = b * c - yz * yz, c01 = xz * yz - xy * c, c02 = xy * yz - xz * b;
+    double c11 = a * c - xz * xz, c12 = xy * xz - a * yz, c22 = a * b - xy * xy;
+    double det = a * c00 + xy * c01 + xz * c02;
+    dem_vec3 x = dem_v3(c00 * f.x + c01 * f.y + c02 * f.z, c01 * f.x + c11 * f.y + c12 * f.z,
+                        c02 * f.x + c12 * f.y + c22 * f.z);
+    return dem_v3_axpy(h / det, x, w->vel[i]);
+}
+
 // Half kick and drift in one pass; flags granules that left the domain.
 static size_t kick_drift(dem_world *restrict w, int *escaped)
 {
@@ -383,7 +404,7 @@ static size_t kick_drift(dem_world *restrict w, int *escaped)
     size_t first_bad = SIZE_MAX;
 #pragma omp parallel for schedule(static) reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
-        dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
+        dem_vec3 v = kicked_velocity(w, i, h, g);
         w->vel[i] = v;
         w->omg[i] = dem_v3_axpy(h * w->inv_inertia[i], w->trq[i], w->omg[i]);
         dem_vec3 p = dem_v3_axpy(dt, v, w->pos[i]);
@@ -408,7 +429,7 @@ static size_t kick(dem_world *restrict w)
     size_t first_bad = SIZE_MAX;
 #pragma omp parallel for schedule(static) reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
-        dem_vec3 v = dem_v3_axpy(h * w->inv_mass[i], w->frc[i], dem_v3_axpy(h, g, w->vel[i]));
+        dem_vec3 v = kicked_velocity(w, i, h, g);
         dem_vec3 o = dem_v3_axpy(h * w->inv_inertia[i], w->trq[i], w->omg[i]);
         w->vel[i] = v;
         w->omg[i] = o;

@@ -66,6 +66,13 @@ typedef struct dem_world_def {
     double skin;                    ///< Verlet skin, m; 0 = 0.2 × smallest radius... see dem_world.c
     dem_lever_arm lever_arm;
     int threads;                    ///< OpenMP threads; 0 = OpenMP's default
+    /// Integrate the normal dashpots semi-implicitly: each granule's velocity
+    /// update sees its own dashpots at the new velocity (backward Euler in
+    /// its own velocity, neighbours explicit), i.e. it is divided by the
+    /// effective mass m·I + Δt·Σγ n nᵀ instead of m. Removes the dashpot from
+    /// the stability limit (left: the spring modes, ω·Δt < 2). Default 0
+    /// (explicit, as in LIGGGHTS) while it is being validated.
+    int implicit_damping;
     /// Accept a configured dt above the stability limit. Only for studies of
     /// the limit itself (tests/stability); never set by configs.
     int allow_unstable_dt;

@@ -56,6 +56,9 @@ struct dem_world {
     // (for each granule, the pairs in which it is j, ascending).
     dem_neighbor_list nl, nl_old;
     dem_vec3 *pair_f, *pair_ti, *pair_tj;
+    dem_vec3 *pair_n;  // contact normal, for the implicit dashpot
+    double *pair_g;    // dashpot coefficient applied, for the implicit dashpot
+    double *damp;      // per granule, 6 doubles: Σγ n nᵀ (xx yy zz xy xz yz)
     size_t pair_cap;
     size_t *rev_start, *rev_pair;
     dem_vec3 *pos_at_build;

@@ -22,9 +22,12 @@
 #define CELLS 4
 #define PRESTRESS 1e-3 // overlap / diameter of nearest neighbours
 
+static int implicit_damping; // the dashpot integration under test
+
 static dem_world_def lattice_def(double dt, int allow)
 {
     dem_world_def def = dem_default_world_def();
+    def.implicit_damping = implicit_damping;
     double a = 2 * R * (1 - PRESTRESS) * sqrt(2.0);
     def.gravity = dem_v3(0, 0, 0);
     def.granule.mu_s = def.granule.mu_r = 1e6; // sticking: springs never truncate
@@ -127,10 +130,13 @@ static void test_limit_is_real(void **state)
 {
     (void)state;
     double limit = engine_limit();
-    // The limit is a bound (highest frequency and strongest dashpot taken
-    // as if in one mode), so steps somewhat above it may still be stable;
-    // far above it the spin mode must blow up, or the bound is meaningless.
-    const double factors[] = {1.0, 1.6, 2.5};
+    // Explicit dashpot: the limit is a bound (highest frequency and strongest
+    // dashpot taken as if in one mode), so steps somewhat above it may still
+    // be stable; far above it the spin mode must blow up, or the bound is
+    // meaningless. Implicit dashpot: the limit is the spring modes' own,
+    // ω·dt = 2, so it is sharp: stable just below, blowing up just above.
+    const double explicit_factors[] = {1.0, 1.6, 2.5}, implicit_factors[] = {0.95, 1.0, 1.1};
+    const double *factors = implicit_damping ? implicit_factors : explicit_factors;
     double worst[3];
     for (size_t k = 0; k < 3; ++k) {
         dem_world *w = make_lattice(factors[k] * limit, 1);
@@ -153,10 +159,27 @@ static void test_step_above_limit_refused(void **state)
     dem_world_destroy(w);
 }
 
+static int explicit_dashpot(void **state)
+{
+    (void)state;
+    implicit_damping = 0;
+    printf("-- explicit dashpot\n");
+    return 0;
+}
+
+static int implicit_dashpot(void **state)
+{
+    (void)state;
+    implicit_damping = 1;
+    printf("-- implicit dashpot\n");
+    return 0;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_default_step_returns_to_rest),
                                        cmocka_unit_test(test_limit_is_real),
                                        cmocka_unit_test(test_step_above_limit_refused)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests_name("explicit dashpot", tests, explicit_dashpot, NULL);
+    return failed + cmocka_run_group_tests_name("implicit dashpot", tests, implicit_dashpot, NULL);
 }

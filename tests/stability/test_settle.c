@@ -37,9 +37,12 @@ static void add_box(dem_world *w)
 
 // Granules on a loose cubic lattice above the floor, sizes from the GSD,
 // small random velocities so the pour is not symmetric.
+static int implicit_damping; // the dashpot integration under test
+
 static dem_world *make_bed(const dem_gsd *gsd)
 {
     dem_world_def def = dem_default_world_def();
+    def.implicit_damping = implicit_damping;
     def.domain_lo = dem_v3(-BOX, -0.01, -BOX);
     def.domain_hi = dem_v3(BOX, 0.5, BOX);
     dem_world *w = dem_world_create(&def, NULL, 0);
@@ -81,13 +84,15 @@ static void settle(const dem_gsd *gsd, const char *label)
     dem_diagnostics d = dem_world_diagnose(w);
     printf("  peak KE %.3e J, worst KE over the last 0.1 s %.3e J (ratio %.1e), %zu granules kept\n", peak,
            worst_late, worst_late / peak, d.granules);
-    // Falls by many orders of magnitude, and stays there (no boiling: the
-    // last 0.1 s never exceeds where it started). It does not fall to zero:
-    // the paper's model has no tangential damping, so rocking modes of
+    // Falls by many orders of magnitude, and stays there. It does not fall to
+    // zero: the paper's model has no tangential damping, so rocking modes of
     // sticking contacts, which never move a normal dashpot, keep what energy
-    // they hold; see README.
+    // they hold (see README) and trade it with the springs, so the KE of the
+    // last 0.1 s swings by tens of per cent. A boiling bed (LIGGGHTS at 0.6
+    // dt_crit: granules at 1-2 m/s) grows by orders of magnitude instead:
+    // the last 0.1 s must stay within 10x of where it started.
     assert_true(worst_late < 1e-4 * peak);
-    assert_true(worst_late <= 1.05 * at_window_start);
+    assert_true(worst_late <= 10.0 * at_window_start);
     // The granules themselves are at rest: what remains is rotation in place.
     printf("  translational KE %.3e J (%.1e of peak)\n", d.ke_translational, d.ke_translational / peak);
     assert_true(d.ke_translational < 1e-7 * peak);
@@ -123,9 +128,17 @@ static void test_narrow_gsd_settles(void **state)
     settle(&g, "narrow GSD (+-10 %)");
 }
 
+static int use_implicit(void **state)
+{
+    (void)state;
+    implicit_damping = 1;
+    return 0;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_wide_gsd_settles),
                                        cmocka_unit_test(test_narrow_gsd_settles)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests_name("explicit dashpot", tests, NULL, NULL);
+    return failed + cmocka_run_group_tests_name("implicit dashpot", tests, use_implicit, NULL);
 }
