@@ -17,6 +17,22 @@ static double spring_energy(const double *hist, unsigned features, const dem_con
     return e;
 }
 
+// Overlap of neighbour-list pair k of granule i (> 0: in contact).
+static double pair_overlap(const dem_world *w, size_t i, size_t k)
+{
+    size_t j = w->nl.j[k];
+    dem_vec3 dv = dem_world_min_image(w, dem_v3_sub(w->pos[j], w->pos[i]));
+    return w->rad[i] + w->rad[j] - dem_v3_norm(dv);
+}
+
+void dem_world_contact_counts(const dem_world *w, unsigned *counts)
+{
+    for (size_t i = 0; i < w->n; ++i) counts[i] = 0;
+    for (size_t i = 0; i < w->n && w->list_valid; ++i)
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k)
+            if (pair_overlap(w, i, k) > 0) counts[i]++, counts[w->nl.j[k]]++;
+}
+
 static void pair_diagnostics(const dem_world *w, dem_diagnostics *d)
 {
     const dem_contact_params *p = &w->def.granule;
@@ -24,8 +40,7 @@ static void pair_diagnostics(const dem_world *w, dem_diagnostics *d)
     for (size_t i = 0; i < w->n && w->list_valid; ++i)
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
             size_t j = w->nl.j[k];
-            dem_vec3 dv = dem_world_min_image(w, dem_v3_sub(w->pos[j], w->pos[i]));
-            double h = w->rad[i] + w->rad[j] - dem_v3_norm(dv);
+            double h = pair_overlap(w, i, k);
             if (!(h > 0)) continue;
             d->contacts++;
             double rmin = w->rad[i] < w->rad[j] ? w->rad[i] : w->rad[j];

@@ -31,7 +31,7 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
-        w->pair_g[k] = 0.0;
+        if (w->def.implicit_damping) w->pair_g[k] = 0.0;
         return;
     }
     const double dist = sqrt(dist2);
@@ -53,8 +53,10 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
     dem_contact_out out;
     dem_contact_eval(&w->gg, &s, hist, &out, mask);
     w->pair_f[k] = out.force;
-    w->pair_g[k] = out.damping_coeff;
-    w->pair_n[k] = n;
+    if (w->def.implicit_damping) { // read only by gather_damping
+        w->pair_g[k] = out.damping_coeff;
+        w->pair_n[k] = n;
+    }
     // Eq. 9–10: torques on i and on j.
     const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
     const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);

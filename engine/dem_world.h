@@ -153,6 +153,9 @@ void dem_world_freeze(dem_world *w);
 
 dem_granules_view dem_world_granules(const dem_world *w);
 dem_diagnostics dem_world_diagnose(const dem_world *w);
+/// Granule–granule contacts (overlap > 0) of each granule, by view index,
+/// into `counts` (granule count entries); the rule dem_world_diagnose counts by.
+void dem_world_contact_counts(const dem_world *w, unsigned *counts);
 double dem_world_time(const dem_world *w);
 double dem_world_dt(const dem_world *w);
 /// The stability limit found by dem_world_prepare (s); 0 before it.

@@ -58,8 +58,6 @@ static int inside_column(dem_vec3 p, const void *ctx)
     return p.x * p.x + p.z * p.z <= inner * inner;
 }
 
-static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return g->position[i].y <= *(double *)ctx; }
-
 // Pour until the bed surface passes the rim; then keep the granules whose
 // centres lie below it.
 static int pour_to_rim(dem_world *w, const exp_cylinder_def *d, const dem_gsd *gsd, exp_progress_fn progress,
@@ -81,23 +79,17 @@ static int pour_to_rim(dem_world *w, const exp_cylinder_def *d, const dem_gsd *g
         next += placed;
     }
     free(diam);
-    double rim = d->depth;
-    dem_world_remove_granules(w, keep_below, &rim);
+    exp_remove_above(w, d->depth);
     return 0;
 }
 
-// Granule–granule contact count of granule i, from the diagnostics' rule
-// (overlap > 0), by brute force over its neighbours in a sorted sweep.
+// Interior coordination number and solid fraction of the bed at rest.
 static void count_contacts(const dem_world *w, const exp_cylinder_def *d, double dmax, exp_cylinder_result *out)
 {
     dem_granules_view g = dem_world_granules(w);
-    int *z = calloc(g.count, sizeof *z);
+    unsigned *z = malloc((g.count + 1) * sizeof *z);
     if (!z) return;
-    for (size_t i = 0; i < g.count; ++i)
-        for (size_t j = i + 1; j < g.count; ++j) {
-            double reach = g.radius[i] + g.radius[j];
-            if (dem_v3_norm2(dem_v3_sub(g.position[i], g.position[j])) < reach * reach) z[i]++, z[j]++;
-        }
+    dem_world_contact_counts(w, z);
     double r = 0.5 * d->diameter, top = 0, sum_in = 0, solid = 0;
     size_t n_in = 0;
     for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y);

@@ -103,26 +103,34 @@ static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *dia
 // granules (as a photograph of a powder shows none) but not the surface.
 static double face_pixel(const exp_drum_def *d) { return d->pixel > 0 ? d->pixel : 0.25 * d->gsd.median_diameter * cbrt(d->lambda); }
 
-// CSA (eq. 20) of the granules whose centres lie at or below y_cut.
-static double csa_below(const dem_world *w, const exp_drum_def *d, double y_cut)
+// The drum face with the granules whose centres lie at or below y_cut
+// projected onto it and closed; NULL on out-of-memory or a failed closing.
+static exp_raster *face_raster(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px, double y_cut)
 {
     dem_granules_view g = dem_world_granules(w);
     double *x = malloc((g.count + 1) * sizeof *x), *y = malloc((g.count + 1) * sizeof *y), *r = malloc((g.count + 1) * sizeof *r);
-    exp_raster *img = exp_raster_create(0.5 * d->diameter, face_pixel(d));
-    double csa = NAN;
-    if (x && y && r && img) {
+    exp_raster *img = exp_raster_create(0.5 * d->diameter, pixel);
+    int ok = x && y && r && img;
+    if (ok) {
         size_t m = 0;
         for (size_t i = 0; i < g.count; ++i)
             if (g.position[i].y <= y_cut) x[m] = g.position[i].x, y[m] = g.position[i].y, r[m++] = g.radius[i];
         exp_raster_paint_discs(img, m, x, y, r);
-        if (exp_raster_close(img, d->closing_px) == 0) csa = exp_raster_csa_percent(img, 0.5 * d->diameter);
+        ok = exp_raster_close(img, closing_px) == 0;
     }
-    exp_raster_free(img);
     free(x), free(y), free(r);
-    return csa;
+    if (!ok) exp_raster_free(img);
+    return ok ? img : NULL;
 }
 
-static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return g->position[i].y <= *(double *)ctx; }
+// CSA (eq. 20) of the granules whose centres lie at or below y_cut.
+static double csa_below(const dem_world *w, const exp_drum_def *d, double y_cut)
+{
+    exp_raster *img = face_raster(w, d, face_pixel(d), d->closing_px, y_cut);
+    double csa = img ? exp_raster_csa_percent(img, 0.5 * d->diameter) : NAN;
+    exp_raster_free(img);
+    return csa;
+}
 
 // Remove the granules above the height at which the bed's CSA is the fill
 // degree (bisection on the cut height).
@@ -134,7 +142,7 @@ static void cut_to_fill(dem_world *w, const exp_drum_def *d)
         if (csa_below(w, d, mid) < target) lo = mid;
         else hi = mid;
     }
-    dem_world_remove_granules(w, keep_below, &hi);
+    exp_remove_above(w, hi);
 }
 
 static dem_world *fill_failed(dem_world *w, double *diam, char *err, size_t len, const char *why)
@@ -154,8 +162,9 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     // stops when the bed's CSA reaches the fill degree.
     size_t cap = 3 * dem_gsd_count_for_volume(&gsd, 0.6 * bed_volume) + 16;
     double *diam = malloc(cap * sizeof *diam);
-    dem_world *w = diam ? create_drum(d, err, len) : NULL;
-    if (!w) return fill_failed(w, diam, err, len, "out of memory");
+    if (!diam) return fill_failed(NULL, diam, err, len, "out of memory");
+    dem_world *w = create_drum(d, err, len);
+    if (!w) return free(diam), NULL; // create_drum wrote the message
     if (dem_gsd_sample(&gsd, d->seed, cap, diam)) return fill_failed(w, diam, err, len, "cannot sample sizes");
     double pitch = 1.05 * dem_gsd_max_diameter(&gsd), target = 100.0 * d->fill;
     for (size_t next = 0; csa_below(w, d, r) < target;) {
@@ -176,24 +185,15 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
 int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px,
                          exp_drum_measure *out)
 {
-    double r = 0.5 * d->diameter;
-    exp_raster *img = exp_raster_create(r, pixel);
+    exp_raster *img = face_raster(w, d, pixel, closing_px, INFINITY);
     if (!img) return 1;
-    dem_granules_view g = dem_world_granules(w);
-    double *x = malloc(g.count * sizeof *x), *y = malloc(g.count * sizeof *y);
-    for (size_t i = 0; x && y && i < g.count; ++i) x[i] = g.position[i].x, y[i] = g.position[i].y;
-    int rc = !x || !y;
-    if (!rc) {
-        exp_raster_paint_discs(img, g.count, x, y, g.radius);
-        rc = exp_raster_close(img, closing_px);
-        out->csa_percent = exp_raster_csa_percent(img, r);
-        exp_angle a;
-        rc = rc || exp_raster_surface_angle(img, r, 0.6, &a);
-        out->angle_deg = fabs(a.angle_deg);
-        out->angle_signed_deg = a.angle_deg;
-        out->angle_fit_sd_m = a.residual_sd;
-    }
-    free(x), free(y);
+    double r = 0.5 * d->diameter;
+    out->csa_percent = exp_raster_csa_percent(img, r);
+    exp_angle a;
+    int rc = exp_raster_surface_angle(img, r, 0.6, &a);
+    out->angle_deg = fabs(a.angle_deg);
+    out->angle_signed_deg = a.angle_deg;
+    out->angle_fit_sd_m = a.residual_sd;
     exp_raster_free(img);
     return rc;
 }

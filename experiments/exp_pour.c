@@ -54,6 +54,10 @@ size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_
     return placed;
 }
 
+static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return g->position[i].y <= *(double *)ctx; }
+
+void exp_remove_above(dem_world *w, double y) { dem_world_remove_granules(w, keep_below, &y); }
+
 int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
 {
     uint64_t chunk = (uint64_t)(0.01 / dem_world_dt(w)) + 1;

@@ -30,6 +30,9 @@ double exp_bed_surface(const dem_world *w, double floor_y);
 size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_y, const double *diam, size_t next,
                       size_t n, double pitch, double density);
 
+/// Remove the granules whose centres lie above height y (a bed cut level).
+void exp_remove_above(dem_world *w, double y);
+
 /// Kinetic energy over (bed mass)·g·d50: the bed is at rest when small.
 double exp_ke_ratio(const dem_world *w, double d50);
 

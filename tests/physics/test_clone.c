@@ -52,6 +52,11 @@ static void test_clone_steps_identically(void **state)
            d.wall_contacts, same(w, c) ? "yes" : "no");
     assert_true(d.contacts > 0 && d.wall_contacts > 0);
     assert_true(same(w, c));
+    // Per-granule counts follow the diagnostics' rule: they sum to 2C.
+    unsigned counts[200], sum = 0;
+    dem_world_contact_counts(w, counts);
+    for (int i = 0; i < 200; ++i) sum += counts[i];
+    assert_int_equal(sum, 2 * d.contacts);
     dem_world_destroy(w); // the clone owns its own memory
     assert_int_equal(dem_world_step(c, 100), DEM_OK);
     dem_world_destroy(c);
