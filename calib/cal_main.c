@@ -13,6 +13,8 @@ static const char main_help[] =
     "usage: granucal COMMAND [options]\n"
     "\n"
     "commands:\n"
+    "  calibrate [CONFIG]    the calibration: stiffness, granule-granule friction, each\n"
+    "                        wall material; writes the parameter table (Table 3)\n"
     "  simulate SCENE.yaml   run one scene file (e.g. the paper's verification test,\n"
     "                        configs/scenes/verification_two_particles.yaml) or a\n"
     "                        drum experiment (configs/drum.yaml)\n"
@@ -26,7 +28,7 @@ typedef struct command {
     int (*run)(int argc, char **argv);
 } command;
 
-static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}};
+static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}, {"calibrate", cal_cmd_calibrate}};
 
 int main(int argc, char **argv)
 {

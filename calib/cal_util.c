@@ -28,7 +28,7 @@ fail:
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len)
 {
     snprintf(a->path, sizeof a->path, "%s", path);
-    snprintf(a->tmp, sizeof a->tmp, "%s.tmp", path);
+    snprintf(a->tmp, sizeof a->tmp, "%s.%ld.tmp", path, (long)getpid()); // per process: two ranks never share a temporary
     a->f = fopen(a->tmp, "w");
     if (!a->f) {
         snprintf(err, err_len, "cannot write '%s': %s", a->tmp, strerror(errno));

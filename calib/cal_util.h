@@ -14,7 +14,7 @@ int cal_mkdirs(const char *path, char *err, size_t err_len);
 /// so a killed run never leaves a half-written file under the final name.
 typedef struct cal_atomic_file {
     FILE *f;
-    char path[1024], tmp[1040];
+    char path[1024], tmp[1064];
 } cal_atomic_file;
 
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len);

@@ -1,0 +1,335 @@
+// SPDX-License-Identifier: MIT
+// `granucal calibrate`: the product. Validates every input, then runs the
+// stages, each from the result store where it can, and writes the table.
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+#include <cyaml/cyaml.h>
+
+#include "cal_commands.h"
+#include "cal_mpi.h"
+#include "cal_report.h"
+#include "cal_util.h"
+#include "exp_common.h"
+#include "exp_yaml.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static const char help[] =
+    "usage: granucal calibrate [CONFIG.yaml] [options]\n"
+    "\n"
+    "Calibrate the linear spring-dashpot model with sliding and rolling friction of a\n"
+    "powder from rotating-drum measurements (Tiscar et al. 2019, section 4):\n"
+    "  1. stiffness: coordination number of a poured cylinder for each candidate k_n;\n"
+    "     keep the smallest k whose CN is within the seed-to-seed noise of the stiff limit;\n"
+    "  2. granule-granule (mu_s, mu_r) in the drum lined with granules: NLopt COBYLA\n"
+    "     minimises the occupied-area (CSA) misfit over the speeds subject to the dynamic\n"
+    "     angle of repose matching the lab's;\n"
+    "  3. each wall material's (mu_s, mu_r), granule-granule frozen, the same way.\n"
+    "\n"
+    "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
+    "(repose_angle.csv: surface,rpm,angle_deg,angle_sd_deg; occupied_area.csv:\n"
+    "surface,rpm,csa_percent,csa_sd_percent), the powder, the candidates, the bounds and\n"
+    "the fidelity tiers. Every input is checked before the first simulation.\n"
+    "\n"
+    "options:\n"
+    "  --tier NAME        fidelity tier from the config (ci, quick, standard, paper, ...)\n"
+    "  --stage STAGE      all (default), stiffness, granule or wall; a later stage reads\n"
+    "                     the earlier stages' results from OUT, else the config's values\n"
+    "  --material NAME    fit this wall material only (implies --stage wall)\n"
+    "  --out DIR          results folder (default results/<config>-<tier>)\n"
+    "  --jobs N           simulations side by side on this machine (default: cores)\n"
+    "  -h, --help         this text\n"
+    "\n"
+    "Resuming: every simulation is stored in OUT/store under a hash of everything that\n"
+    "defines it; run the same command again after a kill and nothing finished is rerun.\n"
+    "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
+    "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
+    "\n"
+    "Outputs in OUT: calibrated_parameters.{csv,md,h5}, simulations.csv, report.md,\n"
+    "cn_vs_k.png, angle_map_*.png, csa_vs_rpm_*.png, convergence_*.png,\n"
+    "liggghts_parameters.in, lammps_parameters.in.\n";
+
+typedef struct options {
+    const char *config, *tier, *stage, *material, *out;
+    int jobs;
+} options;
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
+                                          {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
+                                          {0, 0, 0, 0}};
+    *o = (options){.config = "configs/calibration.yaml", .stage = "all"};
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    o->jobs = ncpu > 0 ? (int)ncpu : 1;
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+        char *end;
+        switch (c) {
+        case 't': o->tier = optarg; break;
+        case 's': o->stage = optarg; break;
+        case 'm': o->material = optarg, o->stage = "wall"; break;
+        case 'o': o->out = optarg; break;
+        case 'j':
+            o->jobs = (int)strtol(optarg, &end, 10);
+            if (*end || o->jobs < 1 || o->jobs > 1024) return fprintf(stderr, "granucal calibrate: --jobs '%s': expected 1..1024\n", optarg), 2;
+            break;
+        case 'h': fputs(help, stdout); return -1;
+        default: fputs("\n", stderr), fputs(help, stderr); return 2;
+        }
+    }
+    if (optind < argc) o->config = argv[optind++];
+    if (optind < argc) return fprintf(stderr, "granucal calibrate: unexpected argument '%s'\n", argv[optind]), 2;
+    const char *stages[] = {"all", "stiffness", "granule", "wall"};
+    for (int k = 0; k < 4; ++k)
+        if (strcmp(o->stage, stages[k]) == 0) return 0;
+    return fprintf(stderr, "granucal calibrate: --stage '%s': use all, stiffness, granule or wall\n", o->stage), 2;
+}
+
+// ---- stage results kept between runs of single stages ---------------------------------
+
+typedef struct stage_file {
+    double k_n, mu_s, mu_r;
+} stage_file;
+static const cyaml_schema_field_t stage_fields[] = {
+    CYAML_FIELD_FLOAT("k_n", CYAML_FLAG_OPTIONAL, stage_file, k_n),
+    CYAML_FIELD_FLOAT("mu_s", CYAML_FLAG_OPTIONAL, stage_file, mu_s),
+    CYAML_FIELD_FLOAT("mu_r", CYAML_FLAG_OPTIONAL, stage_file, mu_r), CYAML_FIELD_END};
+static const cyaml_schema_value_t stage_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, stage_file, stage_fields)};
+
+static int write_stage(const char *dir, const char *name, double k_n, double mu_s, double mu_r, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fprintf(a.f, "# written by granucal calibrate; read by later stages run alone\nk_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
+            k_n, mu_s, mu_r);
+    return cal_atomic_commit(&a, err, len);
+}
+
+// 1 if the stage file exists and was read; -1 if it is damaged.
+static int read_stage(const char *dir, const char *name, stage_file *out, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
+    if (access(path, F_OK) != 0) return 0;
+    stage_file *s = NULL;
+    if (exp_yaml_load(path, &stage_schema, (void **)&s, "delete it to rerun that stage", err, len)) return -1;
+    *out = *s;
+    exp_yaml_free(&stage_schema, s);
+    return 1;
+}
+
+// ---- checks before the first simulation ------------------------------------------------
+
+static int check_surface(const cal_series *angles, const cal_series *areas, const char *surface, char *err, size_t len)
+{
+    const cal_point *p[64];
+    if (cal_series_select(angles, surface, p, 64) == 0)
+        return exp_fail(err, len, "%s: no row for surface '%s' (the config names it)", angles->path, surface);
+    if (cal_series_select(areas, surface, p, 64) == 0)
+        return exp_fail(err, len, "%s: no row for surface '%s' (the config names it)", areas->path, surface);
+    return 0;
+}
+
+static int check_output(const char *dir, char *err, size_t len)
+{
+    char probe[1200];
+    if (cal_mkdirs(dir, err, len)) return 1;
+    snprintf(probe, sizeof probe, "%s/store", dir);
+    if (cal_mkdirs(probe, err, len)) return 1;
+    snprintf(probe, sizeof probe, "%s/.write_test.%ld", dir, (long)getpid());
+    FILE *f = fopen(probe, "w");
+    if (!f || fputs("x", f) < 0 || fclose(f) != 0)
+        return exp_fail(err, len, "%s: results folder is not writable: %s", dir, strerror(errno));
+    unlink(probe);
+    struct statvfs fs;
+    const double need = 50e6; // a calibration's records, tables and plots: a few MB; keep margin
+    if (statvfs(dir, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < need)
+        return exp_fail(err, len, "%s: only %.1f MB free; a calibration needs about %.0f MB", dir,
+                        (double)fs.f_bavail * (double)fs.f_frsize / 1e6, need / 1e6);
+    return 0;
+}
+
+typedef struct run {
+    options opt;
+    cal_config *c;
+    const cal_tier *t;
+    cal_series angles, areas;
+    char out[1024];
+    cal_env env;
+    cal_stiffness_result stiffness;
+    cal_friction_result *granule, *walls[16];
+    int n_walls;
+    cal_table table;
+    char err[2048];
+} run;
+
+static int prepare(run *r)
+{
+    char path[1200];
+    r->c = cal_config_load(r->opt.config, r->opt.tier, r->err, sizeof r->err);
+    if (!r->c) return 1;
+    r->t = cal_config_tier(r->c);
+    cal_config_data_path(r->c, r->c->repose_angle, path, sizeof path);
+    if (cal_series_load(&r->angles, path, CAL_DATA_ANGLE, r->err, sizeof r->err)) return 1;
+    cal_config_data_path(r->c, r->c->occupied_area, path, sizeof path);
+    if (cal_series_load(&r->areas, path, CAL_DATA_CSA, r->err, sizeof r->err)) return 1;
+    if (check_surface(&r->angles, &r->areas, r->c->granule_surface, r->err, sizeof r->err)) return 1;
+    int found = r->opt.material == NULL;
+    for (unsigned k = 0; k < r->c->materials_count; ++k) {
+        if (check_surface(&r->angles, &r->areas, r->c->materials[k].surface, r->err, sizeof r->err)) return 1;
+        found |= r->opt.material && strcasecmp(r->opt.material, r->c->materials[k].name) == 0;
+    }
+    if (!found) return exp_fail(r->err, sizeof r->err, "--material '%s': not under materials in %s", r->opt.material, r->c->path);
+    if (r->opt.out) snprintf(r->out, sizeof r->out, "%s", r->opt.out);
+    else {
+        char stem[1024];
+        const char *base = strrchr(r->c->path, '/');
+        snprintf(stem, sizeof stem, "%s", base ? base + 1 : r->c->path);
+        stem[strcspn(stem, ".")] = '\0';
+        snprintf(r->out, sizeof r->out, "results/%.900s-%.60s", stem, r->t->name);
+    }
+    return check_output(r->out, r->err, sizeof r->err);
+}
+
+static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }
+
+static int stage_stiffness(run *r, double *k_n, const char **source)
+{
+    *k_n = r->c->k_n, *source = "config k_n (stage 1 not run)";
+    if (wants(r, "stiffness")) {
+        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (cylinder λ = %g)\n", r->c->stiffness_count,
+                r->t->seeds, r->t->cylinder_lambda);
+        if (cal_stage_stiffness(&r->env, r->c, r->t, &r->stiffness, r->err, sizeof r->err)) return 1;
+        if (!isfinite(r->stiffness.chosen_k))
+            return exp_fail(r->err, sizeof r->err, "stage 1: no candidate's CN is within the tolerance of the stiff limit");
+        *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)";
+        return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, r->err, sizeof r->err);
+    }
+    stage_file s;
+    int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
+    if (got < 0) return 1;
+    if (got) *k_n = s.k_n, *source = "stage 1, earlier run (stage_stiffness.yaml)";
+    return 0;
+}
+
+static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const char **source)
+{
+    *mu_s = r->c->granule_mu_s, *mu_r = r->c->granule_mu_r, *source = "config granule_mu_s/mu_r (stage 2 not run)";
+    if (wants(r, "granule")) {
+        fprintf(stderr, "== stage 2: granule-granule friction (k_n = %g N/m, drum λ = %g)\n", k_n, r->t->lambda);
+        r->granule = calloc(1, sizeof *r->granule);
+        if (!r->granule) return exp_fail(r->err, sizeof r->err, "out of memory");
+        if (cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, NULL, 0, 0, r->granule, r->err,
+                               sizeof r->err))
+            return 1;
+        const cal_candidate *b = &r->granule->cand[r->granule->best];
+        *mu_s = b->mu_s, *mu_r = b->mu_r;
+        *source = r->granule->best_feasible ? "stage 2 (drum lined with granules)" : "stage 2, closest (angle not matched)";
+        return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, r->err, sizeof r->err);
+    }
+    stage_file s;
+    int got = read_stage(r->out, "granule", &s, r->err, sizeof r->err);
+    if (got < 0) return 1;
+    if (got) *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
+    return 0;
+}
+
+static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
+{
+    if (!wants(r, "wall")) return 0;
+    for (unsigned k = 0; k < r->c->materials_count; ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if (r->opt.material && strcasecmp(r->opt.material, m->name) != 0) continue;
+        fprintf(stderr, "== stage 3: %s wall friction (granule-granule frozen at mu_s = %.4g, mu_r = %.4g)\n", m->name,
+                gg_mu_s, gg_mu_r);
+        cal_friction_result *w = r->walls[r->n_walls++] = calloc(1, sizeof *w);
+        if (!w) return exp_fail(r->err, sizeof r->err, "out of memory");
+        if (cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, w, r->err,
+                               sizeof r->err))
+            return 1;
+        int t = r->table.n_walls++;
+        snprintf(r->table.wall_name[t], 32, "%s", m->name);
+        r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
+        snprintf(r->table.wall_source[t], 96, "%s", w->best_feasible ? "stage 3 (drum lined with it)" : "stage 3, closest (angle not matched)");
+    }
+    return 0;
+}
+
+static void print_table(const char *dir)
+{
+    char path[1200], line[256];
+    snprintf(path, sizeof path, "%s/calibrated_parameters.md", dir);
+    FILE *f = fopen(path, "r");
+    while (f && fgets(line, sizeof line, f)) fputs(line, stdout);
+    if (f) fclose(f);
+    printf("\nresults: %s (report.md, calibrated_parameters.csv, plots)\n", dir);
+}
+
+static int calibrate(run *r, const char *command)
+{
+    double k_n, gg_mu_s, gg_mu_r;
+    const char *k_source, *gg_source;
+    r->env.started = cal_wall_seconds();
+    if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
+        stage_walls(r, k_n, gg_mu_s, gg_mu_r))
+        return 1;
+    r->table.density = r->c->density, r->table.xi = r->c->xi, r->table.k_n = k_n, r->table.k_source = k_source;
+    r->table.gg_mu_s = gg_mu_s, r->table.gg_mu_r = gg_mu_r, r->table.gg_source = gg_source;
+    if (cal_mpi_rank() != 0) return 0;
+    cal_outcome o = {.config = r->c, .tier = r->t, .stiffness = wants(r, "stiffness") ? &r->stiffness : NULL,
+                     .granule = r->granule, .n_walls = r->n_walls, .table = r->table, .command = command,
+                     .wall_time_s = cal_wall_seconds() - r->env.started, .ranks = cal_mpi_size(), .workers = r->env.workers};
+    for (int w = 0; w < r->n_walls; ++w) o.walls[w] = r->walls[w];
+    if (cal_report_write(r->out, &o, r->err, sizeof r->err)) return 1;
+    print_table(r->out);
+    fprintf(stderr, "granucal calibrate: done in %.0f s; %llu simulations run now, the rest from the store\n",
+            o.wall_time_s, r->env.simulations_run);
+    return 0;
+}
+
+int cal_cmd_calibrate(int argc, char **argv)
+{
+    run *r = calloc(1, sizeof *r);
+    if (!r) return fputs("granucal calibrate: out of memory\n", stderr), 1;
+    int status = parse_options(argc, argv, &r->opt);
+    if (status) return free(r), status < 0 ? 0 : status;
+    char command[2048] = "granucal";
+    for (int k = 0; k < argc; ++k)
+        snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
+    cal_mpi_init(&argc, &argv);
+#ifdef _OPENMP
+    // Parallelism is across simulations (processes, ranks); each simulation
+    // runs on one thread, which also keeps forked children clear of the
+    // OpenMP runtime's threads.
+    omp_set_num_threads(1);
+#endif
+    status = prepare(r);
+    if (!status) {
+        snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
+        r->env.workers = r->opt.jobs, r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2);
+        status = calibrate(r, command);
+    }
+    if (status) fprintf(stderr, "granucal calibrate: %s\n", r->err);
+    status = cal_mpi_any(status);
+    cal_series_free(&r->angles), cal_series_free(&r->areas);
+    free(r->granule);
+    for (int w = 0; w < r->n_walls; ++w) free(r->walls[w]);
+    if (r->c) cal_config_free(r->c);
+    free(r);
+    cal_mpi_finalize();
+    return status ? 1 : 0;
+}

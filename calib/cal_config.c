@@ -1,0 +1,237 @@
+// SPDX-License-Identifier: MIT
+// Calibration config: libcyaml schema and field-by-field validation.
+#include "cal_config.h"
+
+#include <cyaml/cyaml.h>
+#include <libgen.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_contact.h"
+#include "exp_common.h"
+#include "exp_scene.h"
+#include "exp_yaml.h"
+
+static const cyaml_schema_value_t float_entry = {CYAML_VALUE_FLOAT(CYAML_FLAG_DEFAULT, double)};
+
+static const cyaml_schema_field_t material_fields[] = {
+    CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_material, name, 1, 31),
+    CYAML_FIELD_STRING_PTR("surface", CYAML_FLAG_POINTER, cal_material, surface, 1, 47), CYAML_FIELD_END};
+static const cyaml_schema_value_t material_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_material, material_fields)};
+
+#define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
+static const cyaml_schema_field_t tier_fields[] = {
+    CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_tier, name, 1, 31),
+    TIER_FLOAT("lambda", lambda, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("slice_depth", slice_depth, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("max_time", max_time, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("window", window, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("sample_interval", sample_interval, CYAML_FLAG_OPTIONAL),
+    TIER_FLOAT("steady_angle_tol_deg", steady_angle_tol_deg, CYAML_FLAG_OPTIONAL),
+    TIER_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
+    TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
+    CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
+    CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
+    CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
+    TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
+    CYAML_FIELD_END};
+static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
+
+static const cyaml_schema_field_t bounds_fields[] = {
+    CYAML_FIELD_FLOAT("mu_s_min", CYAML_FLAG_DEFAULT, cal_bounds, mu_s_min),
+    CYAML_FIELD_FLOAT("mu_s_max", CYAML_FLAG_DEFAULT, cal_bounds, mu_s_max),
+    CYAML_FIELD_FLOAT("mu_r_min", CYAML_FLAG_DEFAULT, cal_bounds, mu_r_min),
+    CYAML_FIELD_FLOAT("mu_r_max", CYAML_FLAG_DEFAULT, cal_bounds, mu_r_max), CYAML_FIELD_END};
+
+#define CFG_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_config, member)
+#define CFG_STRING(key, member, flag, max) CYAML_FIELD_STRING_PTR(key, (flag) | CYAML_FLAG_POINTER, cal_config, member, 1, max)
+static const cyaml_schema_field_t config_fields[] = {
+    CFG_STRING("calibration", calibration, CYAML_FLAG_DEFAULT, 16),
+    CFG_STRING("repose_angle", repose_angle, CYAML_FLAG_DEFAULT, 1000),
+    CFG_STRING("occupied_area", occupied_area, CYAML_FLAG_DEFAULT, 1000),
+    CFG_FLOAT("density", density, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("median_diameter", median_diameter, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("geometric_sd", geometric_sd, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("truncation_sigmas", truncation_sigmas, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("xi", xi, CYAML_FLAG_DEFAULT),
+    CFG_STRING("damping", damping, CYAML_FLAG_OPTIONAL, 32),
+    CFG_FLOAT("diameter", diameter, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("depth", depth, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("fill", fill, CYAML_FLAG_DEFAULT),
+    CFG_STRING("granule_surface", granule_surface, CYAML_FLAG_DEFAULT, 47),
+    CYAML_FIELD_SEQUENCE("materials", CYAML_FLAG_POINTER, cal_config, materials, &material_entry, 0, 16),
+    CYAML_FIELD_SEQUENCE("stiffness", CYAML_FLAG_POINTER, cal_config, stiffness, &float_entry, 2, 64),
+    CFG_FLOAT("stiffness_tolerance", stiffness_tolerance, CYAML_FLAG_OPTIONAL),
+    CFG_FLOAT("k_n", k_n, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("granule_mu_s", granule_mu_s, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("granule_mu_r", granule_mu_r, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("pour_mu_s", pour_mu_s, CYAML_FLAG_DEFAULT),
+    CFG_FLOAT("pour_mu_r", pour_mu_r, CYAML_FLAG_DEFAULT),
+    CYAML_FIELD_MAPPING("granule", CYAML_FLAG_DEFAULT, cal_config, granule, bounds_fields),
+    CYAML_FIELD_MAPPING("wall", CYAML_FLAG_DEFAULT, cal_config, wall, bounds_fields),
+    CFG_STRING("tier", tier, CYAML_FLAG_DEFAULT, 31),
+    CYAML_FIELD_SEQUENCE("tiers", CYAML_FLAG_POINTER, cal_config, tiers, &tier_entry, 1, 16),
+    CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, cal_config, seed),
+    CYAML_FIELD_END};
+static const cyaml_schema_value_t config_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_config, config_fields)};
+
+// "FILE:LINE: FIELD: message", the line found from `from_line` on.
+static int located(const cal_config *c, int from_line, const char *field, char *err, size_t len, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+static int located(const cal_config *c, int from_line, const char *field, char *err, size_t len, const char *fmt, ...)
+{
+    char msg[300];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const char *leaf = strrchr(field, '.');
+    int line = exp_yaml_line_of(c->path, leaf ? leaf + 1 : field, from_line);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", c->path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", c->path, field, msg);
+}
+
+static int bad_positive(double v) { return !(isfinite(v) && v > 0); }
+
+static int check_bounds(const cal_config *c, const cal_bounds *b, const char *name, char *err, size_t len)
+{
+    int from = exp_yaml_line_of(c->path, name, 1);
+    char field[64];
+    snprintf(field, sizeof field, "%s.mu_s_min", name);
+    if (!(b->mu_s_min >= 0 && b->mu_s_min < b->mu_s_max && b->mu_s_max <= 10))
+        return located(c, from, field, err, len, "need 0 <= mu_s_min < mu_s_max <= 10 (got %g, %g)", b->mu_s_min,
+                       b->mu_s_max);
+    snprintf(field, sizeof field, "%s.mu_r_min", name);
+    if (!(b->mu_r_min > 0 && b->mu_r_min < b->mu_r_max && b->mu_r_max <= 10))
+        return located(c, from, field, err, len,
+                       "need 0 < mu_r_min < mu_r_max <= 10 (got %g, %g): mu_r is searched on a log scale", b->mu_r_min,
+                       b->mu_r_max);
+    return 0;
+}
+
+static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
+{
+    char anchor[64];
+    snprintf(anchor, sizeof anchor, "%s", t->name);
+    int from = 1;
+    // The tier's own block starts at its `name:` line.
+    for (int line = exp_yaml_line_of(c->path, "name", 1); line > 0; line = exp_yaml_line_of(c->path, "name", line + 1)) {
+        FILE *f = fopen(c->path, "r");
+        char text[512] = "";
+        for (int k = 0; f && k < line && fgets(text, sizeof text, f); ++k) {}
+        if (f) fclose(f);
+        if (strstr(text, anchor)) { from = line; break; }
+    }
+    struct { const char *field; double v; } positive[] = {
+        {"lambda", t->lambda}, {"max_time", t->max_time}, {"window", t->window}, {"cylinder_lambda", t->cylinder_lambda}};
+    for (size_t k = 0; k < sizeof positive / sizeof *positive; ++k)
+        if (bad_positive(positive[k].v) || (k != 1 && k != 2 && positive[k].v < 1))
+            return located(c, from, positive[k].field, err, len, "%g must be %s", positive[k].v,
+                           (k == 1 || k == 2) ? "> 0" : ">= 1");
+    if (!(t->slice_depth >= 0)) return located(c, from, "slice_depth", err, len, "%g must be >= 0 (0: full drum)", t->slice_depth);
+    if (!(2 * t->window <= t->max_time))
+        return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * t->window,
+                       t->max_time);
+    if (t->seeds < 1 || t->seeds > 64) return located(c, from, "seeds", err, len, "%d must be in [1, 64]", t->seeds);
+    if (t->grid < 0 || t->grid > 16) return located(c, from, "grid", err, len, "%d must be in [0, 16]", t->grid);
+    if (t->max_evaluations < 0 || t->max_evaluations > 1000)
+        return located(c, from, "max_evaluations", err, len, "%d must be in [0, 1000]", t->max_evaluations);
+    if (t->grid < 2 && t->max_evaluations < 1)
+        return located(c, from, "max_evaluations", err, len, "with grid < 2 the search needs evaluations");
+    if (t->seeds < 2 && !(c->stiffness_tolerance > 0))
+        return located(c, from, "seeds", err, len, "one seed gives no spread: use seeds >= 2 or set stiffness_tolerance");
+    if (!(t->angle_sd_deg >= 0 && t->angle_sd_deg < 45))
+        return located(c, from, "angle_sd_deg", err, len, "%g must be in [0, 45)", t->angle_sd_deg);
+    for (unsigned k = 0; k < t->rpm_count; ++k)
+        if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
+    return 0;
+}
+
+static int check_names(const cal_config *c, char *err, size_t len)
+{
+    if (strcmp(c->calibration, "drum") != 0) return located(c, 1, "calibration", err, len, "'%s': must be drum", c->calibration);
+    if (c->damping && dem_damping_mode_from_name(c->damping) < 0)
+        return located(c, 1, "damping", err, len, "'%s': use approaching, always, separating or no_tension", c->damping);
+    for (unsigned k = 0; k < c->materials_count; ++k)
+        for (unsigned j = 0; j < k; ++j)
+            if (strcmp(c->materials[k].name, c->materials[j].name) == 0)
+                return located(c, 1, "materials", err, len, "'%s' is listed twice", c->materials[k].name);
+    for (unsigned k = 0; k < c->tiers_count; ++k)
+        for (unsigned j = 0; j < k; ++j)
+            if (strcmp(c->tiers[k].name, c->tiers[j].name) == 0)
+                return located(c, 1, "tiers", err, len, "tier '%s' is defined twice", c->tiers[k].name);
+    if (!cal_config_tier(c)) return located(c, 1, "tier", err, len, "'%s' is not one of the tiers below", c->tier);
+    return 0;
+}
+
+static int validate(const cal_config *c, char *err, size_t len)
+{
+    struct { const char *field; double v; } positive[] = {
+        {"density", c->density}, {"median_diameter", c->median_diameter}, {"diameter", c->diameter},
+        {"depth", c->depth}, {"k_n", c->k_n}};
+    for (size_t k = 0; k < sizeof positive / sizeof *positive; ++k)
+        if (bad_positive(positive[k].v)) return located(c, 1, positive[k].field, err, len, "%g must be > 0", positive[k].v);
+    if (!(c->geometric_sd >= 1 && c->geometric_sd < 5))
+        return located(c, 1, "geometric_sd", err, len, "%g must be in [1, 5)", c->geometric_sd);
+    if (!(c->truncation_sigmas > 0 && c->truncation_sigmas <= 4))
+        return located(c, 1, "truncation_sigmas", err, len, "%g must be in (0, 4]", c->truncation_sigmas);
+    if (!(c->xi >= 0 && c->xi <= 1)) return located(c, 1, "xi", err, len, "%g must be in [0, 1]", c->xi);
+    if (!(c->fill > 0 && c->fill < 1)) return located(c, 1, "fill", err, len, "%g must be in (0, 1)", c->fill);
+    if (!(c->granule_mu_s >= 0 && c->granule_mu_s <= 10))
+        return located(c, 1, "granule_mu_s", err, len, "%g must be in [0, 10]", c->granule_mu_s);
+    if (!(c->granule_mu_r >= 0 && c->granule_mu_r <= 10))
+        return located(c, 1, "granule_mu_r", err, len, "%g must be in [0, 10]", c->granule_mu_r);
+    if (!(c->pour_mu_s >= 0 && c->pour_mu_s <= 10)) return located(c, 1, "pour_mu_s", err, len, "%g must be in [0, 10]", c->pour_mu_s);
+    if (!(c->pour_mu_r >= 0 && c->pour_mu_r <= 10)) return located(c, 1, "pour_mu_r", err, len, "%g must be in [0, 10]", c->pour_mu_r);
+    if (!(c->stiffness_tolerance >= 0)) return located(c, 1, "stiffness_tolerance", err, len, "%g must be >= 0", c->stiffness_tolerance);
+    for (unsigned k = 0; k < c->stiffness_count; ++k) {
+        if (bad_positive(c->stiffness[k])) return located(c, 1, "stiffness", err, len, "%g must be > 0", c->stiffness[k]);
+        if (k && !(c->stiffness[k] > c->stiffness[k - 1]))
+            return located(c, 1, "stiffness", err, len, "candidates must increase (%g after %g)", c->stiffness[k],
+                           c->stiffness[k - 1]);
+    }
+    if (check_names(c, err, len) || check_bounds(c, &c->granule, "granule", err, len) ||
+        check_bounds(c, &c->wall, "wall", err, len))
+        return 1;
+    for (unsigned k = 0; k < c->tiers_count; ++k)
+        if (check_tier(c, &c->tiers[k], err, len)) return 1;
+    return 0;
+}
+
+cal_config *cal_config_load(const char *path, const char *tier_override, char *err, size_t len)
+{
+    cal_config *c = NULL;
+    if (exp_yaml_load(path, &config_schema, (void **)&c, "see configs/calibration.yaml for every key", err, len))
+        return NULL;
+    snprintf(c->path, sizeof c->path, "%s", path);
+    char copy[1024];
+    snprintf(copy, sizeof copy, "%s", path);
+    snprintf(c->dir, sizeof c->dir, "%s", dirname(copy));
+    if (tier_override) {
+        char *t = strdup(tier_override);
+        if (!t) return cal_config_free(c), exp_fail(err, len, "out of memory"), NULL;
+        free(c->tier); // libcyaml allocates with plain malloc (cyaml_mem)
+        c->tier = t;
+    }
+    if (validate(c, err, len)) return cal_config_free(c), NULL;
+    return c;
+}
+
+void cal_config_free(cal_config *c) { exp_yaml_free(&config_schema, c); }
+
+const cal_tier *cal_config_tier(const cal_config *c)
+{
+    for (unsigned k = 0; k < c->tiers_count; ++k)
+        if (strcmp(c->tiers[k].name, c->tier) == 0) return &c->tiers[k];
+    return NULL;
+}
+
+void cal_config_data_path(const cal_config *c, const char *rel, char *out, size_t len)
+{
+    if (rel[0] == '/') snprintf(out, len, "%s", rel);
+    else snprintf(out, len, "%s/%s", c->dir, rel);
+}

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_config.h
+/// A calibration config (configs/calibration.yaml): the powder, the drum,
+/// the lab data files, the stiffness candidates, the friction bounds, the
+/// wall materials to fit and the fidelity tiers. Loaded with libcyaml and
+/// validated field by field before any simulation starts.
+#ifndef CAL_CONFIG_H
+#define CAL_CONFIG_H
+
+#include <stddef.h>
+
+/// A wall material to fit: its name in the table and its drum lining's name
+/// in the lab data files.
+typedef struct cal_material {
+    char *name;    ///< "aluminium"
+    char *surface; ///< "Aluminium"
+} cal_material;
+
+/// Bounds of a (μs, μr) search; μr is searched on a log scale.
+typedef struct cal_bounds {
+    double mu_s_min, mu_s_max, mu_r_min, mu_r_max;
+} cal_bounds;
+
+/// A fidelity tier: every accuracy knob of the virtual experiments, and
+/// the search budget that goes with it.
+typedef struct cal_tier {
+    char *name;
+    double lambda;          ///< drum coarse-graining factor (eq. 15)
+    double slice_depth;     ///< periodic slice depth, m; 0 = the full drum with end plates
+    double max_time;        ///< s of turning at most per speed
+    double window;          ///< s, steady-state averaging window
+    double sample_interval; ///< s between drum-face measurements
+    double steady_angle_tol_deg, steady_csa_tol_percent;
+    double *rpm;            ///< speeds simulated; empty = every speed in the data
+    unsigned rpm_count;
+    double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
+    int seeds;              ///< poured cylinders per stiffness (seed-to-seed spread)
+    int grid;               ///< initial design: grid points per axis of (μs, log μr)
+    int max_evaluations;    ///< NLopt evaluations after the grid
+    double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
+} cal_tier;
+
+typedef struct cal_config {
+    char *calibration;                 ///< "drum"
+    char *repose_angle, *occupied_area; ///< lab data, relative to the config file
+    double density, median_diameter, geometric_sd, truncation_sigmas, xi;
+    char *damping;
+    double diameter, depth, fill;
+    char *granule_surface;             ///< the granule-lined drum's name in the data files
+    cal_material *materials;
+    unsigned materials_count;
+    double *stiffness;                 ///< k_n candidates of stage 1, N/m (real powder)
+    unsigned stiffness_count;
+    double stiffness_tolerance;        ///< CN tolerance; 0 = from the seed-to-seed spread
+    double k_n;                        ///< stiffness used when stage 1 is skipped
+    double granule_mu_s, granule_mu_r; ///< granule–granule pair used when stage 2 is skipped
+    double pour_mu_s, pour_mu_r;       ///< prior friction of the stage-1 pour (before friction is known)
+    cal_bounds granule, wall;
+    char *tier;                        ///< the tier to run (override: --tier)
+    cal_tier *tiers;
+    unsigned tiers_count;
+    int seed;
+    // Derived on load:
+    char dir[1024];                    ///< directory of the config file
+    char path[1024];
+} cal_config;
+
+/// Load and validate; `tier_override` (may be NULL) replaces `tier`. NULL
+/// with a message naming file, line and field.
+cal_config *cal_config_load(const char *path, const char *tier_override, char *err, size_t len);
+void cal_config_free(cal_config *c);
+
+/// The tier the config selects.
+const cal_tier *cal_config_tier(const cal_config *c);
+
+/// A data path resolved against the config file's directory.
+void cal_config_data_path(const cal_config *c, const char *rel, char *out, size_t len);
+
+#endif

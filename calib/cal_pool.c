@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+// Fork pool (see cal_pool.h).
+#include "cal_pool.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static int run_inline(int n, cal_task_fn task, cal_done_fn done, void *ctx)
+{
+    int failures = 0;
+    for (int i = 0; i < n; ++i) {
+        int code = task(i, ctx);
+        failures += code != 0;
+        if (done) done(i, code, ctx);
+    }
+    return failures;
+}
+
+static int exit_code_of(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status); }
+
+int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int workers, int use_fork)
+{
+    if (!use_fork || n <= 0) return run_inline(n, task, done, ctx);
+    if (workers < 1) workers = 1;
+    pid_t *pids = calloc((size_t)n, sizeof *pids);
+    if (!pids) return run_inline(n, task, done, ctx);
+    int next = 0, running = 0, failures = 0;
+    fflush(NULL); // no buffered output duplicated into the children
+    while (next < n || running > 0) {
+        while (running < workers && next < n) {
+            pid_t pid = fork();
+            if (pid == 0) _exit(task(next, ctx) ? 1 : 0);
+            if (pid < 0) { // no process to spare: run it here
+                int code = task(next, ctx);
+                failures += code != 0;
+                if (done) done(next, code, ctx);
+            } else pids[next] = pid, running++;
+            next++;
+        }
+        int status;
+        pid_t pid = wait(&status);
+        if (pid < 0) break;
+        for (int i = 0; i < n; ++i)
+            if (pids[i] == pid) {
+                pids[i] = 0, running--;
+                int code = exit_code_of(status);
+                failures += code != 0;
+                if (done) done(i, code, ctx);
+            }
+    }
+    free(pids);
+    return failures;
+}

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_pool.h
+/// Independent simulations run side by side on one machine: each in a
+/// forked process of its own (at most `workers` at a time), so a crash is
+/// one failed simulation, not a lost calibration. Without fork (under MPI,
+/// where forking is unsafe) they run one after the other in this process.
+#ifndef CAL_POOL_H
+#define CAL_POOL_H
+
+/// Runs task i; returns 0 on success. In a child, its return is the exit code.
+typedef int (*cal_task_fn)(int i, void *ctx);
+/// Called in the parent when task i ends: `code` is its exit code, or
+/// -signal if it was killed by a signal.
+typedef void (*cal_done_fn)(int i, int code, void *ctx);
+
+/// Run tasks[0..n) with up to `workers` processes. Returns the number of
+/// tasks that did not end with 0.
+int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int workers, int use_fork);
+
+#endif

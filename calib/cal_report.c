@@ -1,0 +1,401 @@
+// SPDX-License-Identifier: MIT
+// The outputs of a calibration (see cal_report.h).
+#include "cal_report.h"
+
+#include <hdf5.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cal_plot.h"
+#include "cal_util.h"
+#include "dem_gsd.h"
+#include "exp_common.h"
+
+// ---- the table ---------------------------------------------------------------
+
+typedef struct row {
+    const char *contact;
+    char material[32];
+    const char *parameter;
+    double value;
+    const char *unit;
+} row;
+
+static int table_rows(const cal_table *t, row *rows)
+{
+    int n = 0;
+    const char *names[] = {"k_n", "k_s", "k_r"};
+    rows[n++] = (row){"granule-granule", "", "density", t->density, "kg/m3"};
+    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-granule", "", names[k], t->k_n, "N/m"};
+    rows[n++] = (row){"granule-granule", "", "xi", t->xi, "-"};
+    rows[n++] = (row){"granule-granule", "", "mu_s", t->gg_mu_s, "-"};
+    rows[n++] = (row){"granule-granule", "", "mu_r", t->gg_mu_r, "-"};
+    // Table 3: a rigid boundary in series with the granule's own spring: 2 k_n.
+    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], 2 * t->k_n, "N/m"};
+    rows[n++] = (row){"granule-boundary", "", "xi", t->xi, "-"};
+    for (int w = 0; w < t->n_walls; ++w) {
+        rows[n] = (row){"granule-boundary", "", "mu_s", t->wall_mu_s[w], "-"};
+        snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
+        rows[n] = (row){"granule-boundary", "", "mu_r", t->wall_mu_r[w], "-"};
+        snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
+    }
+    return n;
+}
+
+static int write_table_csv(const char *dir, const row *rows, int n, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/calibrated_parameters.csv", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fputs("contact,material,parameter,value,unit\n", a.f);
+    for (int i = 0; i < n; ++i)
+        fprintf(a.f, "%s,%s,%s,%.6g,%s\n", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
+    return cal_atomic_commit(&a, err, len);
+}
+
+static int write_table_md(const char *dir, const cal_table *t, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/calibrated_parameters.md", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    fputs("| Contact | Parameter | Material | Value | Source |\n|---|---|---|---|---|\n", f);
+    fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | config |\n", t->density);
+    fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | %s |\n", t->k_n, t->k_source);
+    fprintf(f, "| | Damping ratio ξ | | %g | config |\n", t->xi);
+    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s |\n", t->gg_mu_s, t->gg_source);
+    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s |\n", t->gg_mu_r, t->gg_source);
+    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | 2 k_n, springs in series (Table 3) |\n", 2 * t->k_n);
+    fprintf(f, "| | Damping ratio ξ | | %g | config |\n", t->xi);
+    for (int w = 0; w < t->n_walls; ++w)
+        fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s |\n", t->wall_name[w], t->wall_mu_s[w], t->wall_source[w]);
+    for (int w = 0; w < t->n_walls; ++w)
+        fprintf(f, "| | Rolling friction μr,g-s | %s | %.3g | %s |\n", t->wall_name[w], t->wall_mu_r[w], t->wall_source[w]);
+    return cal_atomic_commit(&a, err, len);
+}
+
+typedef struct h5_row {
+    char contact[24], material[32], parameter[16], unit[8];
+    double value;
+} h5_row;
+
+static int write_table_h5(const char *dir, const row *rows, int n, char *err, size_t len)
+{
+    char path[1200], tmp[1220];
+    snprintf(path, sizeof path, "%s/calibrated_parameters.h5", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    h5_row *data = calloc((size_t)n, sizeof *data);
+    if (!data) return exp_fail(err, len, "out of memory");
+    for (int i = 0; i < n; ++i) {
+        snprintf(data[i].contact, sizeof data[i].contact, "%s", rows[i].contact);
+        snprintf(data[i].material, sizeof data[i].material, "%s", rows[i].material);
+        snprintf(data[i].parameter, sizeof data[i].parameter, "%s", rows[i].parameter);
+        snprintf(data[i].unit, sizeof data[i].unit, "%s", rows[i].unit);
+        data[i].value = rows[i].value;
+    }
+    hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t type = H5Tcreate(H5T_COMPOUND, sizeof(h5_row));
+    size_t sizes[4] = {24, 32, 16, 8};
+    size_t offsets[4] = {offsetof(h5_row, contact), offsetof(h5_row, material), offsetof(h5_row, parameter),
+                         offsetof(h5_row, unit)};
+    const char *names[4] = {"contact", "material", "parameter", "unit"};
+    hid_t strings[4];
+    for (int k = 0; k < 4; ++k) {
+        strings[k] = H5Tcopy(H5T_C_S1);
+        H5Tset_size(strings[k], sizes[k]);
+        H5Tinsert(type, names[k], offsets[k], strings[k]);
+    }
+    H5Tinsert(type, "value", offsetof(h5_row, value), H5T_NATIVE_DOUBLE);
+    hsize_t dims[1] = {(hsize_t)n};
+    hid_t space = H5Screate_simple(1, dims, NULL);
+    hid_t set = file >= 0 ? H5Dcreate2(file, "calibrated_parameters", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
+    int bad = set < 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0;
+    if (set >= 0) H5Dclose(set);
+    H5Sclose(space);
+    for (int k = 0; k < 4; ++k) H5Tclose(strings[k]);
+    H5Tclose(type);
+    if (file >= 0) bad |= H5Fclose(file) < 0;
+    free(data);
+    if (bad || rename(tmp, path) != 0) return exp_fail(err, len, "%s: cannot write", path);
+    return 0;
+}
+
+// ---- the table for other codes -------------------------------------------------
+
+// The paper's dashpot is γ_n = 2ξ sqrt(m* k_n) per pair (eq. 5); LIGGGHTS'
+// hooke/stiffness and LAMMPS' mass_velocity damping take one rate per type
+// pair, γ/m*, which we give for two median granules.
+static double damping_rate(const cal_config *c, double k)
+{
+    double m = c->density * DEM_PI / 6 * pow(c->median_diameter, 3);
+    double m_eff = 0.5 * m;
+    return 2 * c->xi * sqrt(k / m_eff);
+}
+
+static int write_liggghts(const char *dir, const cal_outcome *o, char *err, size_t len)
+{
+    const cal_table *t = &o->table;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/liggghts_parameters.in", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    int n = 1 + t->n_walls;
+    fprintf(f, "# granucal %s: calibrated parameters for LIGGGHTS 3.8, REAL powder (coarse-grain with eq. 15-18).\n"
+               "# atom type 1 = granules", exp_version());
+    for (int w = 0; w < t->n_walls; ++w) fprintf(f, ", %d = %s wall", w + 2, t->wall_name[w]);
+    fprintf(f, "\n# Differences from the paper's model:\n"
+               "#  - hooke/stiffness damps with gamman*m_eff per type pair; the paper's 2*xi*sqrt(m* k) depends on each\n"
+               "#    pair's m*. gamman below is exact for two median granules (and for wall contacts of one).\n"
+               "#  - rolling_friction epsd2 never turns its rolling spring onto the new tangent plane, and sets its\n"
+               "#    rolling stiffness from kt; the paper (and granucal) carry it and use k_r = k_n.\n"
+               "#  - LIGGGHTS 3.8 needs dt <= ~0.35 dt_crit to keep a dense bed at rest with xi = 0.7.\n"
+               "pair_style gran model hooke/stiffness tangential history rolling_friction epsd2 absolute_damping off\n"
+               "pair_coeff * *\n");
+    const char *keys[] = {"kn", "kt", "gamman", "gammat", "coefficientFriction", "coefficientRollingFriction"};
+    for (int p = 0; p < 6; ++p) {
+        fprintf(f, "fix m%d all property/global %s peratomtypepair %d", p + 1, keys[p], n);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                int wall = (i == 0) != (j == 0), gg = i == 0 && j == 0, w = (i ? i : j) - 1;
+                double k = wall ? 2 * t->k_n : t->k_n, v = 0;
+                if (p < 2) v = (gg || wall) ? k : t->k_n;
+                else if (p == 2) v = damping_rate(o->config, k);
+                else if (p == 3) v = 0; // no tangential damping in the paper's model
+                else if (p == 4) v = gg ? t->gg_mu_s : wall ? t->wall_mu_s[w] : 0;
+                else v = gg ? t->gg_mu_r : wall ? t->wall_mu_r[w] : 0;
+                fprintf(f, " %.6g", v);
+            }
+        fputc('\n', f);
+    }
+    return cal_atomic_commit(&a, err, len);
+}
+
+static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t len)
+{
+    const cal_table *t = &o->table;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/lammps_parameters.in", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    fprintf(f, "# granucal %s: calibrated parameters for LAMMPS pair_style granular, REAL powder.\n"
+               "# Differences from the paper's model: damping mass_velocity takes one rate per type pair\n"
+               "# (gamma/m*, exact for two median granules); rolling sds has its own spring history\n"
+               "# (carried like the paper's); no tangential damping (xgammat = 0).\n"
+               "pair_style granular\n", exp_version());
+    fprintf(f, "pair_coeff 1 1 hooke %.6g %.6g tangential linear_history %.6g 0 %.6g rolling sds %.6g 0 %.6g "
+               "damping mass_velocity\n",
+            t->k_n, damping_rate(o->config, t->k_n), t->k_n, t->gg_mu_s, t->k_n, t->gg_mu_r);
+    for (int w = 0; w < t->n_walls; ++w)
+        fprintf(f, "# %s wall (fix wall/gran ... granular with the same keywords):\n"
+                   "#   hooke %.6g %.6g tangential linear_history %.6g 0 %.6g rolling sds %.6g 0 %.6g damping mass_velocity\n",
+                t->wall_name[w], 2 * t->k_n, damping_rate(o->config, 2 * t->k_n), 2 * t->k_n, t->wall_mu_s[w],
+                2 * t->k_n, t->wall_mu_r[w]);
+    return cal_atomic_commit(&a, err, len);
+}
+
+// ---- every simulation ------------------------------------------------------------
+
+static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store)
+{
+    const char *stage = r->material[0] ? r->material : "granule";
+    for (int i = 0; i < r->n; ++i) {
+        const cal_candidate *k = &r->cand[i];
+        cal_drum_case dc = r->material[0]
+                               ? cal_drum_case_make(o->config, o->tier, r->k_n, r->frozen_mu_s, r->frozen_mu_r, k->mu_s, k->mu_r)
+                               : cal_drum_case_make(o->config, o->tier, r->k_n, k->mu_s, k->mu_r, k->mu_s, k->mu_r);
+        double rpm[CAL_MAX_RPM + 1];
+        int n = r->n_rpm;
+        memcpy(rpm, r->rpm, sizeof(double) * (size_t)n);
+        int has_angle = 0;
+        for (int j = 0; j < n; ++j) has_angle |= rpm[j] == r->angle_rpm;
+        if (!has_angle) rpm[n++] = r->angle_rpm;
+        for (int j = 0; j < n; ++j) {
+            char key[2048], hash[17], err[256];
+            cal_drum_key(&dc, rpm[j], key, sizeof key);
+            cal_store_hash(key, hash);
+            cal_record rec;
+            if (cal_store_get(store, key, &rec, err, sizeof err) != 0) continue;
+            fprintf(f, "%s,%d,%s,drum,%.6g,%.6g,%g,%s,\"%s\",%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.1f,%.4g,%d,%.6g\n", stage,
+                    i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
+                    rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s,
+                    rec.wall_time_s, rec.particle_steps, rec.granules, rec.dt_s);
+            cal_record_free(&rec);
+        }
+    }
+}
+
+static int write_simulations(const char *dir, const char *store, const cal_outcome *o, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/simulations.csv", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fputs("stage,candidate,record,experiment,mu_s,mu_r,rpm_or_k_n,status,reason,angle_deg,angle_sd_deg,csa_percent,"
+          "csa_sd_percent,steady,simulated_time_s,wall_time_s,particle_steps,granules,dt_s_or_coordination\n",
+          a.f);
+    const cal_stiffness_result *s = o->stiffness;
+    for (int i = 0; s && i < s->n; ++i)
+        for (int j = 0; j < o->tier->seeds; ++j) {
+            exp_cylinder_def cd = cal_cylinder_case_make(o->config, o->tier, s->k[i], (uint64_t)(o->config->seed + j));
+            char key[2048], hash[17], e2[256];
+            cal_cylinder_key(&cd, key, sizeof key);
+            cal_store_hash(key, hash);
+            cal_record rec;
+            if (cal_store_get(store, key, &rec, e2, sizeof e2) != 0) continue;
+            fprintf(a.f, "stiffness,%d,%s,cylinder,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,,%d,%.5f\n", i + 1, hash,
+                    cd.granule.mu_s, cd.granule.mu_r, s->k[i], rec.status, rec.reason ? rec.reason : "",
+                    rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination);
+            cal_record_free(&rec);
+        }
+    if (o->granule) simulations_of(a.f, o, o->granule, store);
+    for (int w = 0; w < o->n_walls; ++w) simulations_of(a.f, o, o->walls[w], store);
+    return cal_atomic_commit(&a, err, len);
+}
+
+// ---- plots -------------------------------------------------------------------------
+
+static int plot_stiffness(const char *dir, const cal_stiffness_result *s, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/cn_vs_k.png", dir);
+    cal_chart c = {.title = "Stage 1: coordination number of the poured cylinder (Fig. 12)",
+                   .xlabel = "granule stiffness k_n (N/m, real powder)", .ylabel = "coordination number (granule-granule)",
+                   .log_x = 1, .hline = s->stiff_limit - s->tolerance, .hline_label = "stiff limit - tolerance"};
+    c.series[c.n_series++] = (cal_series_xy){"mean over seeds (bars: sd)", s->k, s->cn_mean, s->cn_sd, s->n, 1, 1, 0.1, 0.3, 0.8};
+    double kx[1] = {s->chosen_k}, ky[1] = {NAN};
+    for (int i = 0; i < s->n; ++i)
+        if (s->k[i] == s->chosen_k) ky[0] = s->cn_mean[i];
+    c.series[c.n_series++] = (cal_series_xy){"chosen k_n", kx, ky, NULL, 1, 0, 1, 0.9, 0.1, 0.1};
+    return cal_plot_chart(path, &c, err, len);
+}
+
+static int plot_friction(const char *dir, const cal_outcome *o, const cal_friction_result *r, char *err, size_t len)
+{
+    const char *stage = r->material[0] ? r->material : "granule";
+    const cal_bounds *b = r->material[0] ? &o->config->wall : &o->config->granule;
+    double mu_s[CAL_MAX_EVALS], mu_r[CAL_MAX_EVALS], angle[CAL_MAX_EVALS], misfit[CAL_MAX_EVALS], best[CAL_MAX_EVALS],
+        index[CAL_MAX_EVALS];
+    double running = HUGE_VAL;
+    for (int i = 0; i < r->n; ++i) {
+        mu_s[i] = r->cand[i].mu_s, mu_r[i] = r->cand[i].mu_r, angle[i] = r->cand[i].angle_deg;
+        misfit[i] = r->cand[i].misfit, index[i] = i + 1;
+        if (r->cand[i].angle_violation <= 0) running = fmin(running, misfit[i]);
+        best[i] = isfinite(running) ? running : NAN;
+    }
+    char path[1200], title[160];
+    snprintf(path, sizeof path, "%s/angle_map_%s.png", dir, stage);
+    snprintf(title, sizeof title, "%s: dynamic angle of repose at %g rpm (Fig. %s)", stage, r->angle_rpm,
+             r->material[0] ? "17" : "13");
+    if (cal_plot_angle_map(path, title, mu_s, mu_r, angle, r->n, o->tier->grid, r->angle_target, r->angle_tolerance,
+                           r->best, b->mu_s_min, b->mu_s_max, b->mu_r_min, b->mu_r_max, err, len))
+        return 1;
+    snprintf(path, sizeof path, "%s/convergence_%s.png", dir, stage);
+    cal_chart conv = {.title = "search convergence", .xlabel = "evaluation", .ylabel = "CSA misfit (mean squared z)",
+                      .log_y = 1, .hline = NAN};
+    conv.series[conv.n_series++] = (cal_series_xy){"each candidate", index, misfit, NULL, r->n, 0, 1, 0.5, 0.5, 0.5};
+    conv.series[conv.n_series++] = (cal_series_xy){"best matching the angle", index, best, NULL, r->n, 1, 0, 0.8, 0.1, 0.1};
+    if (cal_plot_chart(path, &conv, err, len)) return 1;
+    // CSA curves: the data, the chosen pair, and other pairs matching the angle (Fig. 16, 19).
+    snprintf(path, sizeof path, "%s/csa_vs_rpm_%s.png", dir, stage);
+    snprintf(title, sizeof title, "%s: occupied cross-section area (Fig. %s)", stage, r->material[0] ? "19" : "16");
+    cal_chart c = {.title = title, .xlabel = "drum speed (rpm)", .ylabel = "CSA (%)", .hline = NAN};
+    c.series[c.n_series++] = (cal_series_xy){"lab data", r->rpm, r->csa_data, r->csa_data_sd, r->n_rpm, 0, 1, 0, 0, 0};
+    static char labels[CAL_PLOT_MAX_SERIES][64];
+    double palette[5][3] = {{0.85, 0.1, 0.1}, {0.1, 0.4, 0.85}, {0.1, 0.6, 0.2}, {0.6, 0.2, 0.7}, {0.9, 0.5, 0.0}};
+    int shown = 0;
+    for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i < r->n && c.n_series < 7; ++i) {
+            int chosen = i == r->best, matching = r->cand[i].angle_violation <= 0;
+            if ((pass == 0) != chosen || (pass == 1 && !matching)) continue;
+            snprintf(labels[c.n_series], 64, "%s%.3g / %.3g", chosen ? "chosen " : "", r->cand[i].mu_s, r->cand[i].mu_r);
+            const double *col = palette[shown++ % 5];
+            c.series[c.n_series++] = (cal_series_xy){labels[c.n_series], r->rpm, r->cand[i].csa, r->cand[i].csa_sd,
+                                                     r->n_rpm, 1, 1, col[0], col[1], col[2]};
+        }
+    return cal_plot_chart(path, &c, err, len);
+}
+
+// ---- report -------------------------------------------------------------------------
+
+static void report_friction(FILE *f, const cal_friction_result *r)
+{
+    const char *stage = r->material[0] ? r->material : "granule-granule";
+    fprintf(f, "\n## %s (surface '%s' in the data)\n\n", stage, r->surface);
+    if (r->material[0]) fprintf(f, "Granule–granule frozen at μs = %.4g, μr = %.4g. ", r->frozen_mu_s, r->frozen_mu_r);
+    fprintf(f, "Target angle %.2f° at %g rpm, tolerance ±%.2f° (lab spread and this tier's spread combined). "
+               "CSA at %d speeds. NLopt COBYLA: %s. %d candidates, %.0f s.\n\n",
+            r->angle_target, r->angle_rpm, r->angle_tolerance, r->n_rpm, r->nlopt_result, r->n, r->wall_time_s);
+    if (r->best >= 0) {
+        const cal_candidate *b = &r->cand[r->best];
+        fprintf(f, "**Chosen:** μs = %.4g, μr = %.4g: angle %.2f° ± %.2f, CSA misfit %.3g%s.\n\n", b->mu_s, b->mu_r,
+                b->angle_deg, b->angle_sd_deg, b->misfit,
+                r->best_feasible ? "" : " — **no candidate matched the angle within its tolerance; this is the closest**");
+    }
+    fputs("Pairs matching the angle within the tolerance (the paper's ambiguity):\n\n| μs | μr | angle (°) | CSA misfit |"
+          "\n|---|---|---|---|\n", f);
+    int any = 0;
+    for (int i = 0; i < r->n; ++i)
+        if (r->cand[i].angle_violation <= 0)
+            any = 1, fprintf(f, "| %.4g | %.4g | %.2f | %.3g |\n", r->cand[i].mu_s, r->cand[i].mu_r, r->cand[i].angle_deg,
+                             r->cand[i].misfit);
+    if (!any) fputs("| none | | | |\n", f);
+    fputs("\nCSA of the chosen pair against the data:\n\n| rpm | data (%) | simulated (%) | steady |\n|---|---|---|---|\n", f);
+    for (int j = 0; r->best >= 0 && j < r->n_rpm; ++j)
+        fprintf(f, "| %g | %.2f ± %.2f | %.2f ± %.2f | %s |\n", r->rpm[j], r->csa_data[j], r->csa_data_sd[j],
+                r->cand[r->best].csa[j], r->cand[r->best].csa_sd[j], r->cand[r->best].usable[j] ? "yes" : "no");
+}
+
+static int write_report(const char *dir, const cal_outcome *o, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/report.md", dir);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    const cal_tier *t = o->tier;
+    fprintf(f, "# granucal calibration\n\nCommand: `%s`  \nConfig: `%s`, tier `%s` (drum λ = %g, %s, up to %g s per "
+               "speed, window %g s; cylinder λ = %g), granucal %s, %d rank(s) × %d worker(s), %.0f s wall.\n\n",
+            o->command, o->config->path, t->name, t->lambda, t->slice_depth > 0 ? "periodic slice" : "full drum",
+            t->max_time, t->window, t->cylinder_lambda, exp_version(), o->ranks, o->workers, o->wall_time_s);
+    fputs("Files: `calibrated_parameters.{csv,md,h5}`, `simulations.csv` (every simulation, its cost and status), "
+          "plots `cn_vs_k.png`, `angle_map_*.png`, `csa_vs_rpm_*.png`, `convergence_*.png`, and "
+          "`liggghts_parameters.in`, `lammps_parameters.in`.\n", f);
+    const cal_stiffness_result *s = o->stiffness;
+    if (s) {
+        fprintf(f, "\n## Stiffness (poured cylinder, pour friction μs = %g, μr = %g)\n\n| k_n (N/m) | CN mean | CN sd | "
+                   "wall contacts/granule | solid fraction | granules | failed seeds |\n|---|---|---|---|---|---|---|\n",
+                o->config->pour_mu_s, o->config->pour_mu_r);
+        for (int i = 0; i < s->n; ++i)
+            fprintf(f, "| %g | %.3f | %.3f | %.3f | %.3f | %d | %d |\n", s->k[i], s->cn_mean[i], s->cn_sd[i], s->wall_cn[i],
+                    s->solid_fraction[i], s->granules[i], s->failed[i]);
+        fprintf(f, "\nStiff limit %.3f (the stiffest candidate); tolerance %.3f (%s). Chosen: **k_n = %g N/m**, the "
+                   "smallest k from which every stiffer candidate stays within the tolerance.\n",
+                s->stiff_limit, s->tolerance, s->tolerance_rule, s->chosen_k);
+    }
+    if (o->granule) report_friction(f, o->granule);
+    for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w]);
+    return cal_atomic_commit(&a, err, len);
+}
+
+int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t len)
+{
+    row rows[64];
+    int n = table_rows(&o->table, rows);
+    char store[1100];
+    snprintf(store, sizeof store, "%s/store", dir);
+    if (write_table_csv(dir, rows, n, err, len) || write_table_md(dir, &o->table, err, len) ||
+        write_table_h5(dir, rows, n, err, len) || write_liggghts(dir, o, err, len) || write_lammps(dir, o, err, len) ||
+        write_simulations(dir, store, o, err, len) || write_report(dir, o, err, len))
+        return 1;
+    if (o->stiffness && isfinite(o->stiffness->chosen_k) && plot_stiffness(dir, o->stiffness, err, len)) return 1;
+    if (o->granule && plot_friction(dir, o, o->granule, err, len)) return 1;
+    for (int w = 0; w < o->n_walls; ++w)
+        if (plot_friction(dir, o, o->walls[w], err, len)) return 1;
+    return 0;
+}

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_report.h
+/// What a calibration writes into its results folder: the table (Table 3's
+/// layout) as CSV, Markdown and HDF5; every simulation; the plots; the
+/// table as input for LIGGGHTS and LAMMPS; and a report with the evidence
+/// behind every number.
+#ifndef CAL_REPORT_H
+#define CAL_REPORT_H
+
+#include "cal_stages.h"
+
+/// The calibrated values and where each came from.
+typedef struct cal_table {
+    double density, xi, k_n;
+    const char *k_source;
+    double gg_mu_s, gg_mu_r;
+    const char *gg_source;
+    int n_walls;
+    char wall_name[16][32];
+    double wall_mu_s[16], wall_mu_r[16];
+    char wall_source[16][96];
+} cal_table;
+
+/// Everything the run found; stages not run are NULL.
+typedef struct cal_outcome {
+    const cal_config *config;
+    const cal_tier *tier;
+    const cal_stiffness_result *stiffness;
+    const cal_friction_result *granule;
+    const cal_friction_result *walls[16];
+    int n_walls;
+    cal_table table;
+    const char *command;
+    double wall_time_s;
+    int ranks, workers;
+} cal_outcome;
+
+/// Write every output into dir. 0 on success, else 1 with a message.
+int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t len);
+
+#endif

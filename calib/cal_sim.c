@@ -1,0 +1,283 @@
+// SPDX-License-Identifier: MIT
+// Calibration simulations through the result store (see cal_sim.h).
+#include "cal_sim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cal_mpi.h"
+#include "cal_pool.h"
+#include "cal_util.h"
+#include "exp_common.h"
+
+cal_drum_case cal_drum_case_make(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+                                 double wall_mu_s, double wall_mu_r)
+{
+    cal_drum_case d;
+    d.def = exp_default_drum_def();
+    d.def.diameter = c->diameter, d.def.fill = c->fill;
+    d.def.periodic = t->slice_depth > 0;
+    d.def.depth = d.def.periodic ? t->slice_depth : c->depth;
+    d.def.lambda = t->lambda, d.def.density = c->density, d.def.seed = (uint64_t)c->seed;
+    d.def.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
+    int mode = c->damping ? dem_damping_mode_from_name(c->damping) : DEM_DAMPING_APPROACHING;
+    // Table 3: k_n = k_s = k_r; the boundary has twice the stiffness (springs in series).
+    d.def.granule = (dem_contact_params){k_n, k_n, k_n, c->xi, gg_mu_s, gg_mu_r, (dem_damping_mode)mode};
+    d.def.wall = (dem_contact_params){2 * k_n, 2 * k_n, 2 * k_n, c->xi, wall_mu_s, wall_mu_r, (dem_damping_mode)mode};
+    d.def.end_plate = d.def.wall;
+    d.run = exp_default_drum_run_opts();
+    d.run.max_time = t->max_time, d.run.window = t->window;
+    if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
+    if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
+    if (t->steady_csa_tol_percent > 0) d.run.csa_tol_percent = t->steady_csa_tol_percent;
+    return d;
+}
+
+exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed)
+{
+    exp_cylinder_def d = exp_default_cylinder_def();
+    d.lambda = t->cylinder_lambda, d.density = c->density, d.seed = seed;
+    d.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
+    int mode = c->damping ? dem_damping_mode_from_name(c->damping) : DEM_DAMPING_APPROACHING;
+    // Stage 1 comes before the friction is known: the pour uses the config's
+    // stated prior friction (pour_mu_s, pour_mu_r). The stage reads how the
+    // coordination number moves with k, not its level.
+    d.granule = (dem_contact_params){k_n, k_n, k_n, c->xi, c->pour_mu_s, c->pour_mu_r, (dem_damping_mode)mode};
+    d.wall = d.granule; // its stiffness is set to 2 k_n by exp_cylinder (Table 3)
+    return d;
+}
+
+static void contact_text(char *out, size_t len, const dem_contact_params *p)
+{
+    snprintf(out, len, "k=%.10g,%.10g,%.10g xi=%.10g mu=%.10g,%.10g damping=%d", p->k_n, p->k_s, p->k_r, p->xi,
+             p->mu_s, p->mu_r, (int)p->damping);
+}
+
+void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
+{
+    const exp_drum_def *d = &c->def;
+    const exp_drum_run_opts *r = &c->run;
+    char gg[160], wall[160], plate[160];
+    contact_text(gg, sizeof gg, &d->granule), contact_text(wall, sizeof wall, &d->wall);
+    contact_text(plate, sizeof plate, &d->end_plate);
+    snprintf(out, len,
+             "drum v=%s D=%.10g depth=%.10g periodic=%d fill=%.10g lambda=%.10g rho=%.10g gsd=%.10g,%.10g,%.10g "
+             "granule[%s] wall[%s] plate[%s] pixel=%.10g closing=%d seed=%llu rpm=%.10g max_time=%.10g "
+             "sample=%.10g window=%.10g tol=%.10g,%.10g network_dt=%d",
+             exp_version(), d->diameter, d->depth, d->periodic, d->fill, d->lambda, d->density, d->gsd.median_diameter,
+             d->gsd.geometric_sd, d->gsd.truncation_sigmas, gg, wall, d->periodic ? "none" : plate, d->pixel,
+             d->closing_px, (unsigned long long)d->seed, rpm, r->max_time, r->sample_interval, r->window,
+             r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt);
+}
+
+void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
+{
+    char gg[160], wall[160];
+    contact_text(gg, sizeof gg, &c->granule), contact_text(wall, sizeof wall, &c->wall);
+    snprintf(out, len, "cylinder v=%s D=%.10g depth=%.10g lambda=%.10g rho=%.10g gsd=%.10g,%.10g,%.10g granule[%s] "
+                       "wall[%s] seed=%llu",
+             exp_version(), c->diameter, c->depth, c->lambda, c->density, c->gsd.median_diameter, c->gsd.geometric_sd,
+             c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
+}
+
+static void show_done(const cal_env *env, const char *what, const cal_record *r)
+{
+    double wall = cal_wall_seconds() - env->started;
+    if (env->tty) fputs("\r\033[K", stderr);
+    fprintf(stderr, "[%s] %s: %s", env->stage, what, r->status);
+    if (r->reason && r->reason[0]) fprintf(stderr, " (%s)", r->reason);
+    if (r->granules && strncmp(what, "cylinder", 8) == 0)
+        fprintf(stderr, ", CN %.3f, %d granules", r->coordination, r->granules);
+    else if (r->granules)
+        fprintf(stderr, ", angle %.1f° ± %.1f, CSA %.1f %% ± %.1f", r->angle_deg, r->angle_sd_deg, r->csa_percent,
+                r->csa_sd_percent);
+    fprintf(stderr, " — %.2f s simulated in %.0f s; %.0f s elapsed\n", r->simulated_time_s, r->wall_time_s, wall);
+}
+
+// A record every rank must find once a batch is done.
+static int read_back(const cal_env *env, const char *key, cal_record *out, char *err, size_t len)
+{
+    int got = cal_store_get(env->store, key, out, err, len);
+    if (got == 1) exp_fail(err, len, "no record in %s after running '%s'", env->store, key);
+    return got != 0;
+}
+
+// ---- drum -----------------------------------------------------------------
+
+typedef struct drum_batch {
+    cal_env *env;
+    const cal_drum_case *c;
+    dem_world *bed;
+    double bed_wall_s;
+    const double *rpm;
+    int *todo;             ///< indices into rpm of this rank's missing runs
+    char keys[32][2048];
+    char err[512];
+} drum_batch;
+
+static int write_failed(const cal_env *env, const char *key, const char *reason)
+{
+    char err[512];
+    cal_record r = {.key = (char *)key, .status = "failed", .reason = (char *)reason};
+    if (cal_store_put(env->store, &r, err, sizeof err)) return fprintf(stderr, "granucal calibrate: %s\n", err), 1;
+    return 0;
+}
+
+static int turn_one(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    int k = b->todo[i];
+    exp_drum_run_opts run = b->c->run;
+    run.rpm = b->rpm[k];
+    // In a forked child the bed is this process's own copy; inline, turn a clone.
+    dem_world *w = b->env->use_fork ? b->bed : dem_world_clone(b->bed);
+    if (!w) return write_failed(b->env, b->keys[k], "out of memory copying the settled bed"), 1;
+    double t0 = cal_wall_seconds();
+    exp_drum_result res;
+    dem_status st = exp_drum_rotate(w, &b->c->def, &run, NULL, NULL, &res);
+    cal_record r = {.key = b->keys[k], .reason = ""};
+    r.status = st != DEM_OK ? "failed" : res.steady ? "ok" : "not steady";
+    if (st != DEM_OK) r.reason = (char *)dem_world_error(w);
+    r.angle_deg = res.angle_deg, r.angle_sd_deg = res.angle_sd_deg;
+    r.csa_percent = res.csa_percent, r.csa_sd_percent = res.csa_sd_percent;
+    r.steady = res.steady, r.simulated_time_s = res.simulated_time_s;
+    r.wall_time_s = cal_wall_seconds() - t0 + b->bed_wall_s; // the bed's cost is shared by every speed
+    r.dt_s = dem_world_dt(w), r.particle_steps = (double)res.particle_steps, r.granules = (int)res.granules;
+    char err[512];
+    int bad = cal_store_put(b->env->store, &r, err, sizeof err);
+    if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
+    if (!b->env->use_fork) dem_world_destroy(w);
+    return bad;
+}
+
+static void turned(int i, int code, void *ctx)
+{
+    drum_batch *b = ctx;
+    int k = b->todo[i];
+    char what[64], err[512];
+    snprintf(what, sizeof what, "%g rpm", b->rpm[k]);
+    if (code < 0) { // killed by a signal: the child wrote nothing
+        char reason[64];
+        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
+        write_failed(b->env, b->keys[k], reason);
+    }
+    cal_record r;
+    if (cal_store_get(b->env->store, b->keys[k], &r, err, sizeof err) == 0) {
+        show_done(b->env, what, &r);
+        cal_record_free(&r);
+    }
+    b->env->simulations_run++;
+}
+
+// Fill this rank's bed and turn it at each of its missing speeds.
+static void run_missing_drum(drum_batch *b, int n_todo)
+{
+    double t0 = cal_wall_seconds();
+    char err[1024];
+    b->bed = exp_drum_fill(&b->c->def, NULL, NULL, err, sizeof err);
+    b->bed_wall_s = cal_wall_seconds() - t0;
+    if (!b->bed) {
+        for (int i = 0; i < n_todo; ++i) write_failed(b->env, b->keys[b->todo[i]], err);
+        return;
+    }
+    cal_pool_run(n_todo, turn_one, turned, b, b->env->workers, b->env->use_fork);
+    dem_world_destroy(b->bed);
+}
+
+int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
+                      size_t len)
+{
+    if (n > 32) return exp_fail(err, len, "at most 32 speeds per candidate"), 1;
+    drum_batch *b = calloc(1, sizeof *b);
+    int todo[32], n_todo = 0, n_missing = 0;
+    if (!b) return exp_fail(err, len, "out of memory"), 1;
+    *b = (drum_batch){.env = env, .c = c, .rpm = rpm, .todo = todo};
+    cal_mpi_barrier(); // every rank sees the same store, so all deal the missing runs alike
+    for (int k = 0; k < n; ++k) {
+        cal_drum_key(c, rpm[k], b->keys[k], sizeof b->keys[k]);
+        int got = cal_store_get(env->store, b->keys[k], &out[k], err, len);
+        if (got < 0) return free(b), 1;
+        if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k;
+        if (got == 0) cal_record_free(&out[k]);
+    }
+    int bad = 0;
+    if (n_todo > 0) run_missing_drum(b, n_todo);
+    cal_mpi_barrier(); // every rank's records are on the shared store now
+    for (int k = 0; k < n && !bad; ++k)
+        bad = read_back(env, b->keys[k], &out[k], err, len);
+    free(b);
+    return bad;
+}
+
+// ---- poured cylinder --------------------------------------------------------
+
+typedef struct cylinder_batch {
+    cal_env *env;
+    const exp_cylinder_def *cases;
+    int *todo;
+    char (*keys)[2048];
+} cylinder_batch;
+
+static int pour_one(int i, void *ctx)
+{
+    cylinder_batch *b = ctx;
+    int k = b->todo[i];
+    double t0 = cal_wall_seconds();
+    char err[1024];
+    exp_cylinder_result res;
+    dem_world *w = exp_cylinder_run(&b->cases[k], NULL, NULL, &res, err, sizeof err);
+    if (!w) return write_failed(b->env, b->keys[k], err), 1;
+    cal_record r = {.key = b->keys[k], .status = "ok", .reason = ""};
+    r.coordination = res.coordination, r.coordination_interior = res.coordination_interior;
+    r.wall_contacts_per_granule = res.wall_contacts_per_granule, r.solid_fraction = res.solid_fraction;
+    r.steady = 1, r.simulated_time_s = res.simulated_time_s, r.wall_time_s = cal_wall_seconds() - t0;
+    r.dt_s = dem_world_dt(w), r.granules = (int)res.granules;
+    dem_world_destroy(w);
+    int bad = cal_store_put(b->env->store, &r, err, sizeof err);
+    if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
+    return bad;
+}
+
+static void poured(int i, int code, void *ctx)
+{
+    cylinder_batch *b = ctx;
+    int k = b->todo[i];
+    char what[96], err[512];
+    if (code < 0) {
+        char reason[64];
+        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
+        write_failed(b->env, b->keys[k], reason);
+    }
+    snprintf(what, sizeof what, "cylinder k_n = %g N/m, seed %llu", b->cases[k].granule.k_n,
+             (unsigned long long)b->cases[k].seed);
+    cal_record r;
+    if (cal_store_get(b->env->store, b->keys[k], &r, err, sizeof err) == 0) {
+        show_done(b->env, what, &r);
+        cal_record_free(&r);
+    }
+    b->env->simulations_run++;
+}
+
+int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len)
+{
+    char(*keys)[2048] = calloc((size_t)n, sizeof *keys);
+    int *todo = calloc((size_t)n, sizeof *todo), n_todo = 0, n_missing = 0, bad = 0;
+    if (!keys || !todo) return free(keys), free(todo), exp_fail(err, len, "out of memory"), 1;
+    cal_mpi_barrier();
+    for (int k = 0; k < n && !bad; ++k) {
+        cal_cylinder_key(&cases[k], keys[k], sizeof keys[k]);
+        int got = cal_store_get(env->store, keys[k], &out[k], err, len);
+        bad = got < 0;
+        if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k;
+        if (got == 0) cal_record_free(&out[k]);
+    }
+    cylinder_batch b = {env, cases, todo, keys};
+    if (!bad && n_todo > 0) cal_pool_run(n_todo, pour_one, poured, &b, env->workers, env->use_fork);
+    cal_mpi_barrier();
+    for (int k = 0; k < n && !bad; ++k)
+        bad = read_back(env, keys[k], &out[k], err, len);
+    free(keys), free(todo);
+    return bad;
+}

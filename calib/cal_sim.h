@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_sim.h
+/// The simulations a calibration asks for, through the result store: a
+/// drum candidate (one settled bed turned at each speed) and a poured
+/// cylinder. What is stored is never run again; what is missing is dealt
+/// out over MPI ranks and, on each machine, over worker processes.
+#ifndef CAL_SIM_H
+#define CAL_SIM_H
+
+#include <stdint.h>
+
+#include "cal_config.h"
+#include "cal_store.h"
+#include "exp_cylinder.h"
+#include "exp_drum.h"
+
+/// How simulations are run and reported.
+typedef struct cal_env {
+    char store[1100];   ///< record directory
+    int workers;        ///< processes per machine
+    int use_fork;
+    int tty;            ///< progress on a terminal
+    const char *stage;  ///< label of the current stage, for progress lines
+    double started;     ///< wall clock at the start of the calibration
+    unsigned long long simulations_run; ///< by this process (the rest came from the store)
+} cal_env;
+
+/// A drum candidate: the drum and powder, and how each speed is run.
+typedef struct cal_drum_case {
+    exp_drum_def def;
+    exp_drum_run_opts run;
+} cal_drum_case;
+
+/// The drum of the config at its tier, with granule stiffness k_n and the
+/// given friction pairs (granule–granule; granule–wall lining).
+cal_drum_case cal_drum_case_make(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+                                 double wall_mu_s, double wall_mu_r);
+
+/// The poured cylinder of stage 1 at stiffness k_n and seed.
+exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);
+
+/// The text that defines a simulation (hashed into its record's name).
+void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len);
+void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
+
+/// Records of the drum candidate at each speed, running the missing ones.
+/// 0 when every record is in hand (failed simulations included), else 1
+/// with a message (the store could not be read or written).
+int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
+                      size_t len);
+
+/// Records of poured cylinders, running the missing ones side by side.
+int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len);
+
+#endif

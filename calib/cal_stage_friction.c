@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: MIT
+// Stages 2 and 3 (sections 4.2, 4.3): find (μs, μr) so that the drum's
+// dynamic angle of repose matches the lab's and its occupied-area curve
+// (eq. 20) fits best. The paper's three steps (pairs that match the angle;
+// their CSA curves; the best of them) as one problem for NLopt's COBYLA:
+//   minimise   the CSA misfit           (mean squared, in data standard deviations)
+//   subject to |angle - target| <= tol  (tol: the lab's and the tier's spreads combined)
+// over μs and log10 μr, scaled to the unit square. A grid over the square
+// comes first: it maps the angle over the plane (Fig. 13, 17), shows the
+// ambiguity (every pair matching the angle) and starts COBYLA from its best
+// point. Every candidate uses the same seed and therefore the same settled
+// bed procedure, so the objective is deterministic.
+#include <math.h>
+#include <nlopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cal_stages.h"
+#include "cal_util.h"
+#include "exp_common.h"
+
+/// A failed or unsteady speed counts as a misfit of 5 data standard deviations
+/// (the search steers away from it without stopping).
+static const double failed_speed_penalty = 25.0;
+/// The lab's CSA spread is floored: a quoted 0 would make one speed dominate.
+static const double min_csa_sd = 0.1;
+
+typedef struct search {
+    cal_env *env;
+    const cal_config *c;
+    const cal_tier *t;
+    const cal_material *material;
+    cal_friction_result *r;
+    double sim_rpm[CAL_MAX_RPM]; ///< speeds simulated: the CSA speeds, and the angle's
+    int n_sim, angle_index;
+    int failed;                  ///< the store failed: stop the search
+    nlopt_opt opt;
+    char *err;
+    size_t len;
+} search;
+
+static double to_mu_s(const cal_bounds *b, double u) { return b->mu_s_min + u * (b->mu_s_max - b->mu_s_min); }
+static double to_mu_r(const cal_bounds *b, double v)
+{
+    return pow(10, log10(b->mu_r_min) + v * (log10(b->mu_r_max) - log10(b->mu_r_min)));
+}
+static const cal_bounds *bounds_of(const search *s) { return s->material ? &s->c->wall : &s->c->granule; }
+
+static void score(search *s, cal_candidate *k, const cal_record *rec)
+{
+    cal_friction_result *r = s->r;
+    const cal_record *a = &rec[s->angle_index];
+    k->angle_deg = cal_record_usable(a) ? a->angle_deg : NAN;
+    k->angle_sd_deg = a->angle_sd_deg;
+    k->angle_violation = isfinite(k->angle_deg) ? fabs(k->angle_deg - r->angle_target) - r->angle_tolerance : 90;
+    double sum = 0;
+    for (int i = 0; i < r->n_rpm; ++i) {
+        const cal_record *x = NULL;
+        for (int j = 0; j < s->n_sim; ++j)
+            if (s->sim_rpm[j] == r->rpm[i]) x = &rec[j];
+        k->usable[i] = x && cal_record_usable(x) && x->steady;
+        k->csa[i] = x ? x->csa_percent : NAN, k->csa_sd[i] = x ? x->csa_sd_percent : NAN;
+        double z = (k->csa[i] - r->csa_data[i]) / fmax(r->csa_data_sd[i], min_csa_sd);
+        sum += k->usable[i] ? z * z : failed_speed_penalty;
+    }
+    k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
+}
+
+static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
+{
+    cal_friction_result *r = s->r;
+    const cal_bounds *b = bounds_of(s);
+    double mu_s = to_mu_s(b, u), mu_r = to_mu_r(b, v);
+    for (int i = 0; i < r->n; ++i) // a point seen before (COBYLA revisits): no new simulation
+        if (r->cand[i].mu_s == mu_s && r->cand[i].mu_r == mu_r) return &r->cand[i];
+    if (r->n >= CAL_MAX_EVALS || s->failed) return NULL;
+    cal_drum_case dc = s->material ? cal_drum_case_make(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
+                                   : cal_drum_case_make(s->c, s->t, r->k_n, mu_s, mu_r, mu_s, mu_r);
+    cal_record rec[CAL_MAX_RPM];
+    double t0 = cal_wall_seconds();
+    if (s->env->tty) fprintf(stderr, "\r\033[K[%s] candidate %d: mu_s = %.4g, mu_r = %.4g ...", s->env->stage, r->n + 1, mu_s, mu_r);
+    else fprintf(stderr, "[%s] candidate %d: mu_s = %.4g, mu_r = %.4g\n", s->env->stage, r->n + 1, mu_s, mu_r);
+    if (cal_drum_evaluate(s->env, &dc, s->sim_rpm, s->n_sim, rec, s->err, s->len)) {
+        s->failed = 1;
+        return NULL;
+    }
+    cal_candidate *k = &r->cand[r->n++];
+    memset(k, 0, sizeof *k);
+    k->mu_s = mu_s, k->mu_r = mu_r, k->from_grid = from_grid;
+    score(s, k, rec);
+    for (int i = 0; i < s->n_sim; ++i) k->wall_time_s += rec[i].wall_time_s, cal_record_free(&rec[i]);
+    double elapsed = cal_wall_seconds() - t0;
+    fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g (%.0f s)\n",
+            s->env->tty ? "\r\033[K" : "", s->env->stage, r->n, mu_s, mu_r, k->angle_deg, r->angle_target,
+            r->angle_tolerance, k->misfit, elapsed);
+    return k;
+}
+
+static double objective(unsigned n, const double *x, double *grad, void *ctx)
+{
+    (void)n, (void)grad;
+    search *s = ctx;
+    cal_candidate *k = evaluate(s, x[0], x[1], 0);
+    if (!k) return nlopt_force_stop(s->opt), HUGE_VAL;
+    return k->misfit;
+}
+
+static double angle_constraint(unsigned n, const double *x, double *grad, void *ctx)
+{
+    (void)n, (void)grad;
+    search *s = ctx;
+    cal_candidate *k = evaluate(s, x[0], x[1], 0); // the same point as the objective: from the list
+    return k ? k->angle_violation : 0;
+}
+
+// Feasible candidates first, by misfit; else the least violation.
+static int better(const cal_candidate *a, const cal_candidate *b)
+{
+    int fa = a->angle_violation <= 0, fb = b->angle_violation <= 0;
+    if (fa != fb) return fa;
+    return fa ? a->misfit < b->misfit : a->angle_violation < b->angle_violation;
+}
+
+static int best_of(const cal_friction_result *r)
+{
+    int best = -1;
+    for (int i = 0; i < r->n; ++i)
+        if (isfinite(r->cand[i].angle_deg) && (best < 0 || better(&r->cand[i], &r->cand[best]))) best = i;
+    return best;
+}
+
+static void unit_coordinates(const search *s, const cal_candidate *k, double *u, double *v)
+{
+    const cal_bounds *b = bounds_of(s);
+    *u = (k->mu_s - b->mu_s_min) / (b->mu_s_max - b->mu_s_min);
+    *v = (log10(k->mu_r) - log10(b->mu_r_min)) / (log10(b->mu_r_max) - log10(b->mu_r_min));
+}
+
+static const char *run_cobyla(search *s)
+{
+    int start = best_of(s->r);
+    if (s->t->max_evaluations < 1) return "not run (max_evaluations = 0)";
+    nlopt_opt opt = s->opt = nlopt_create(NLOPT_LN_COBYLA, 2);
+    double lo[2] = {0, 0}, hi[2] = {1, 1}, x[2] = {0.5, 0.5}, fx;
+    double step = s->t->grid > 1 ? 0.5 / s->t->grid : 0.25;
+    double dx[2] = {step, step};
+    if (start >= 0) unit_coordinates(s, &s->r->cand[start], &x[0], &x[1]);
+    nlopt_set_lower_bounds(opt, lo), nlopt_set_upper_bounds(opt, hi);
+    nlopt_set_min_objective(opt, objective, s);
+    nlopt_add_inequality_constraint(opt, angle_constraint, s, 0.0);
+    nlopt_set_initial_step(opt, dx);
+    nlopt_set_xtol_abs1(opt, 0.01); // 1 % of each range: finer than the drum can resolve at any tier
+    nlopt_set_maxeval(opt, s->t->max_evaluations);
+    nlopt_result res = nlopt_optimize(opt, x, &fx);
+    nlopt_destroy(opt);
+    switch (res) {
+    case NLOPT_XTOL_REACHED: return "converged (step below 1 % of the ranges)";
+    case NLOPT_MAXEVAL_REACHED: return "stopped at max_evaluations";
+    case NLOPT_FORCED_STOP: return "stopped: a simulation could not be stored";
+    default: return res > 0 ? "converged" : "NLopt failed";
+    }
+}
+
+// The speeds to simulate, the targets and tolerances, from the data files.
+static int set_targets(search *s, const cal_series *angles, const cal_series *areas)
+{
+    cal_friction_result *r = s->r;
+    const cal_point *pts[64];
+    size_t n = cal_series_select(angles, r->surface, pts, 64);
+    if (n == 0) return exp_fail(s->err, s->len, "%s: no angle of repose for surface '%s'", angles->path, r->surface);
+    r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
+    r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + s->t->angle_sd_deg * s->t->angle_sd_deg);
+    n = cal_series_select(areas, r->surface, pts, 64);
+    if (n == 0) return exp_fail(s->err, s->len, "%s: no occupied area for surface '%s'", areas->path, r->surface);
+    for (size_t i = 0; i < n; ++i) {
+        int wanted = s->t->rpm_count == 0;
+        for (unsigned j = 0; j < s->t->rpm_count; ++j) wanted |= s->t->rpm[j] == pts[i]->rpm;
+        if (!wanted) continue;
+        if (r->n_rpm == CAL_MAX_RPM) return exp_fail(s->err, s->len, "at most %d speeds", CAL_MAX_RPM);
+        r->rpm[r->n_rpm] = pts[i]->rpm, r->csa_data[r->n_rpm] = pts[i]->value, r->csa_data_sd[r->n_rpm] = pts[i]->sd;
+        s->sim_rpm[s->n_sim++] = pts[i]->rpm;
+        r->n_rpm++;
+    }
+    if (r->n_rpm == 0) return exp_fail(s->err, s->len, "tier '%s': none of its speeds is in %s for '%s'", s->t->name, areas->path, r->surface);
+    s->angle_index = -1;
+    for (int j = 0; j < s->n_sim; ++j)
+        if (s->sim_rpm[j] == r->angle_rpm) s->angle_index = j;
+    if (s->angle_index < 0) s->angle_index = s->n_sim, s->sim_rpm[s->n_sim++] = r->angle_rpm;
+    return 0;
+}
+
+int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                       const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
+                       double gg_mu_r, cal_friction_result *out, char *err, size_t len)
+{
+    memset(out, 0, sizeof *out);
+    double t0 = cal_wall_seconds();
+    snprintf(out->material, sizeof out->material, "%s", material ? material->name : "");
+    snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
+    out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
+    static char stage[64];
+    snprintf(stage, sizeof stage, "%s", material ? material->name : "granule");
+    env->stage = stage;
+    search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len};
+    if (set_targets(&s, angles, areas)) return 1;
+    for (int i = 0; i < t->grid && !s.failed; ++i)
+        for (int j = 0; j < t->grid && !s.failed; ++j) evaluate(&s, (i + 0.5) / t->grid, (j + 0.5) / t->grid, 1);
+    out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
+    out->best = best_of(out);
+    out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
+    out->wall_time_s = cal_wall_seconds() - t0;
+    if (s.failed) return 1;
+    if (out->best < 0) return exp_fail(err, len, "%s: every candidate failed; see simulations.csv", stage);
+    return 0;
+}

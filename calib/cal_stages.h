@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_stages.h
+/// The three stages of the calibration (the paper's section 4):
+///   1. stiffness: coordination number of a poured cylinder against k_n;
+///   2. granule–granule (μs, μr) in the drum lined with granules;
+///   3. each wall material's (μs, μr), granule–granule frozen.
+#ifndef CAL_STAGES_H
+#define CAL_STAGES_H
+
+#include "cal_config.h"
+#include "cal_data.h"
+#include "cal_sim.h"
+
+enum { CAL_MAX_K = 64, CAL_MAX_EVALS = 512, CAL_MAX_RPM = 16 };
+
+typedef struct cal_stiffness_result {
+    int n;                       ///< stiffness candidates
+    double k[CAL_MAX_K];
+    double cn_mean[CAL_MAX_K], cn_sd[CAL_MAX_K]; ///< over seeds
+    double wall_cn[CAL_MAX_K], solid_fraction[CAL_MAX_K];
+    int granules[CAL_MAX_K], failed[CAL_MAX_K];
+    double stiff_limit;          ///< CN at the stiffest candidate
+    double tolerance;            ///< |CN - stiff limit| allowed
+    const char *tolerance_rule;  ///< how the tolerance was set
+    double chosen_k;
+    double wall_time_s;
+} cal_stiffness_result;
+
+int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, cal_stiffness_result *out, char *err,
+                        size_t len);
+
+/// One evaluated (μs, μr) candidate.
+typedef struct cal_candidate {
+    double mu_s, mu_r;
+    double angle_deg, angle_sd_deg;     ///< at the angle's speed
+    double csa[CAL_MAX_RPM], csa_sd[CAL_MAX_RPM];
+    int usable[CAL_MAX_RPM];            ///< steady and not failed
+    double misfit;                      ///< mean squared CSA misfit in data standard deviations (+ penalties)
+    double angle_violation;             ///< |angle - target| - tolerance (≤ 0: matches)
+    int from_grid;
+    double wall_time_s;
+} cal_candidate;
+
+/// What a friction stage found.
+typedef struct cal_friction_result {
+    char material[32];                  ///< "" for granule–granule
+    char surface[64];
+    double k_n;
+    double frozen_mu_s, frozen_mu_r;    ///< granule–granule pair (wall stage)
+    double angle_target, angle_tolerance, angle_rpm;
+    int n_rpm;
+    double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
+    int n;                              ///< candidates evaluated
+    cal_candidate cand[CAL_MAX_EVALS];
+    int best;                           ///< index of the chosen candidate, -1 if none usable
+    int best_feasible;                  ///< 1 if it matches the angle
+    const char *nlopt_result;
+    double wall_time_s;
+} cal_friction_result;
+
+/// Stage 2 (material == NULL) or 3 (a material of the config).
+int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                       const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
+                       double gg_mu_r, cal_friction_result *out, char *err, size_t len);
+
+#endif

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: MIT
+// Result store: YAML records read back with libcyaml (see cal_store.h).
+#include "cal_store.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cal_util.h"
+#include "exp_common.h"
+#include "exp_yaml.h"
+
+#define REC_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, cal_record, member)
+static const cyaml_schema_field_t record_fields[] = {
+    CYAML_FIELD_STRING_PTR("key", CYAML_FLAG_POINTER, cal_record, key, 1, 4096),
+    CYAML_FIELD_STRING_PTR("status", CYAML_FLAG_POINTER, cal_record, status, 1, 32),
+    CYAML_FIELD_STRING_PTR("reason", CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, cal_record, reason, 0, 1024),
+    REC_FLOAT("angle_deg", angle_deg), REC_FLOAT("angle_sd_deg", angle_sd_deg), REC_FLOAT("csa_percent", csa_percent),
+    REC_FLOAT("csa_sd_percent", csa_sd_percent), REC_FLOAT("coordination", coordination),
+    REC_FLOAT("coordination_interior", coordination_interior),
+    REC_FLOAT("wall_contacts_per_granule", wall_contacts_per_granule), REC_FLOAT("solid_fraction", solid_fraction),
+    CYAML_FIELD_BOOL("steady", CYAML_FLAG_OPTIONAL, cal_record, steady), REC_FLOAT("simulated_time_s", simulated_time_s),
+    REC_FLOAT("wall_time_s", wall_time_s), REC_FLOAT("dt_s", dt_s), REC_FLOAT("particle_steps", particle_steps),
+    CYAML_FIELD_INT("granules", CYAML_FLAG_OPTIONAL, cal_record, granules), CYAML_FIELD_END};
+static const cyaml_schema_value_t record_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_record, record_fields)};
+
+void cal_store_hash(const char *key, char out[17])
+{
+    uint64_t h = 1469598103934665603ULL; // FNV-1a 64
+    for (const unsigned char *p = (const unsigned char *)key; *p; ++p) h = (h ^ *p) * 1099511628211ULL;
+    snprintf(out, 17, "%016" PRIx64, h);
+}
+
+void cal_store_path(const char *dir, const char *key, char *out, size_t len)
+{
+    char hash[17];
+    cal_store_hash(key, hash);
+    snprintf(out, len, "%s/%s.yaml", dir, hash);
+}
+
+int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len)
+{
+    char path[1200];
+    cal_store_path(dir, key, path, sizeof path);
+    memset(out, 0, sizeof *out);
+    if (access(path, F_OK) != 0) return 1;
+    cal_record *r = NULL;
+    if (exp_yaml_load(path, &record_schema, (void **)&r, "a damaged store record: delete it to rerun that simulation",
+                      err, len))
+        return -1;
+    if (strcmp(r->key, key) != 0) {
+        exp_yaml_free(&record_schema, r);
+        return exp_fail(err, len, "%s: holds a different simulation (hash collision); delete it", path), -1;
+    }
+    *out = *r;
+    free(r); // the strings now belong to *out
+    return 0;
+}
+
+// YAML single-quoted scalar: quotes doubled, line breaks flattened.
+static void put_quoted(FILE *f, const char *name, const char *s)
+{
+    fprintf(f, "%s: '", name);
+    for (; s && *s; ++s) {
+        if (*s == '\'') fputs("''", f);
+        else fputc(*s == '\n' || *s == '\r' ? ' ' : *s, f);
+    }
+    fputs("'\n", f);
+}
+
+int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
+{
+    char path[1200];
+    cal_store_path(dir, r->key, path, sizeof path);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    put_quoted(a.f, "key", r->key);
+    put_quoted(a.f, "status", r->status);
+    put_quoted(a.f, "reason", r->reason ? r->reason : "");
+    fprintf(a.f,
+            "angle_deg: %.17g\nangle_sd_deg: %.17g\ncsa_percent: %.17g\ncsa_sd_percent: %.17g\n"
+            "coordination: %.17g\ncoordination_interior: %.17g\nwall_contacts_per_granule: %.17g\n"
+            "solid_fraction: %.17g\nsteady: %s\nsimulated_time_s: %.17g\nwall_time_s: %.6g\ndt_s: %.17g\n"
+            "particle_steps: %.17g\ngranules: %d\n",
+            r->angle_deg, r->angle_sd_deg, r->csa_percent, r->csa_sd_percent, r->coordination,
+            r->coordination_interior, r->wall_contacts_per_granule, r->solid_fraction, r->steady ? "true" : "false",
+            r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->granules);
+    return cal_atomic_commit(&a, err, len);
+}
+
+void cal_record_free(cal_record *r)
+{
+    free(r->key), free(r->status), free(r->reason);
+    r->key = r->status = r->reason = NULL;
+}
+
+int cal_record_usable(const cal_record *r) { return r->status && strcmp(r->status, "failed") != 0; }

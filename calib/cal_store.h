@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_store.h
+/// The result store of a calibration run: one small YAML record per
+/// simulation, named by a hash of the text that defines the simulation
+/// (scene, parameters, seed, tier, engine version) and written under a
+/// temporary name, then renamed. A killed run leaves whole records or none;
+/// a rerun finds every finished simulation and runs only the rest.
+#ifndef CAL_STORE_H
+#define CAL_STORE_H
+
+#include <stddef.h>
+
+/// What one simulation measured. Drum runs fill the angle/CSA fields,
+/// poured cylinders the coordination fields.
+typedef struct cal_record {
+    char *key;     ///< the defining text (checked on read: no hash collision goes unnoticed)
+    char *status;  ///< "ok", "not steady" or "failed"
+    char *reason;  ///< why it failed, or ""
+    double angle_deg, angle_sd_deg, csa_percent, csa_sd_percent;
+    double coordination, coordination_interior, wall_contacts_per_granule, solid_fraction;
+    int steady;
+    double simulated_time_s, wall_time_s, dt_s, particle_steps;
+    int granules;
+} cal_record;
+
+/// 64-bit FNV-1a of the key, as 16 hex digits.
+void cal_store_hash(const char *key, char out[17]);
+
+/// Path of a key's record in `dir`.
+void cal_store_path(const char *dir, const char *key, char *out, size_t len);
+
+/// Read the record of `key`: 0 found (fields filled, free with
+/// cal_record_free), 1 absent, -1 unreadable or a different key (message).
+int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len);
+
+/// Write a record atomically. 0 on success.
+int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len);
+
+void cal_record_free(cal_record *r);
+
+/// 1 if the record holds a usable measurement (not failed).
+int cal_record_usable(const cal_record *r);
+
+#endif

@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// YAML loading with located errors (see exp_yaml.h).
+#include "exp_yaml.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "exp_common.h"
+#include "exp_scene.h"
+
+typedef struct log_capture {
+    char problem[256]; ///< the first error libcyaml reported
+    char field[64];    ///< innermost field of the backtrace
+    int line;          ///< its line
+} log_capture;
+
+static void chomp(char *s)
+{
+    size_t n = strlen(s);
+    while (n && (s[n - 1] == '\n' || s[n - 1] == ' ')) s[--n] = '\0';
+}
+
+// libcyaml logs "Load: <problem>", then "Load: Backtrace:", then lines
+// "  in mapping field 'x' (line: L, column: C)" from the innermost out.
+static void capture(cyaml_log_t level, void *ctx, const char *fmt, va_list args)
+{
+    log_capture *c = ctx;
+    char text[256];
+    if (level < CYAML_LOG_ERROR) return;
+    vsnprintf(text, sizeof text, fmt, args);
+    chomp(text);
+    const char *body = strncmp(text, "Load: ", 6) == 0 ? text + 6 : text;
+    if (strstr(body, "Backtrace:") == body) return;
+    if (!c->problem[0]) {
+        snprintf(c->problem, sizeof c->problem, "%s", body);
+        return;
+    }
+    int line = 0;
+    const char *at = strstr(body, "(line: ");
+    if (at && c->line == 0 && sscanf(at, "(line: %d", &line) == 1) {
+        c->line = line;
+        const char *q = strchr(body, '\'');
+        const char *q2 = q ? strchr(q + 1, '\'') : NULL;
+        if (q && q2 && q2 - q - 1 < (long)sizeof c->field) snprintf(c->field, sizeof c->field, "%.*s", (int)(q2 - q - 1), q + 1);
+    }
+}
+
+static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
+
+int exp_yaml_load(const char *path, const cyaml_schema_value_t *schema, void **out, const char *hint, char *err,
+                  size_t len)
+{
+    log_capture c = {{0}, {0}, 0};
+    cyaml_config_t cfg = {.log_fn = capture, .log_ctx = &c, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
+    *out = NULL;
+    cyaml_err_t e = cyaml_load_file(path, &cfg, schema, (cyaml_data_t **)out, NULL);
+    if (e == CYAML_OK) return 0;
+    const char *why = c.problem[0] ? c.problem : cyaml_strerror(e);
+    // An unknown key is reported against its enclosing mapping; find the key's own line.
+    char key[64] = {0};
+    if (sscanf(why, "Unexpected key: %63s", key) == 1) {
+        int line = exp_yaml_line_of(path, key, 1);
+        if (line > 0) c.line = line;
+        snprintf(c.field, sizeof c.field, "%s", key);
+    }
+    char where[96] = "";
+    if (c.line > 0) snprintf(where, sizeof where, "%d: ", c.line);
+    if (c.field[0]) snprintf(where + strlen(where), sizeof where - strlen(where), "%s: ", c.field);
+    if (hint) return exp_fail(err, len, "%s:%s%s (%s)", path, where, why, hint);
+    return exp_fail(err, len, "%s:%s%s", path, where, why);
+}
+
+void exp_yaml_free(const cyaml_schema_value_t *schema, void *data)
+{
+    if (data) cyaml_free(&quiet, schema, data, 0);
+}
