@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: MIT
+// The calibration's inputs are checked before any simulation: the shipped
+// lab data and config load; malformed, empty, truncated and hostile files
+// are refused with the file, the line and the field named.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "cal_config.h"
+#include "cal_data.h"
+#include "cal_store.h"
+
+static char source[1024];
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void test_shipped_angles_are_table_2(void **state)
+{
+    (void)state;
+    char path[1200], err[512];
+    snprintf(path, sizeof path, "%s/experiments/data/repose_angle.csv", source);
+    cal_series s;
+    if (cal_series_load(&s, path, CAL_DATA_ANGLE, err, sizeof err)) fail_msg("%s", err);
+    const cal_point *p[8];
+    // Table 2 of the paper.
+    assert_int_equal(cal_series_select(&s, "PTFE", p, 8), 1), assert_true(p[0]->value == 31.9 && p[0]->rpm == 4);
+    assert_int_equal(cal_series_select(&s, "pp", p, 8), 1), assert_true(p[0]->value == 32.2);
+    assert_int_equal(cal_series_select(&s, "Aluminium", p, 8), 1), assert_true(p[0]->value == 34.2);
+    assert_int_equal(cal_series_select(&s, "spray-dried powder", p, 8), 1), assert_true(p[0]->value == 34.6);
+    cal_series_free(&s);
+}
+
+// Each bad file must fail with "path:line: field" in the message.
+static void expect_csv_error(const char *text, int line, const char *field)
+{
+    char path[] = "/tmp/granucal_csv_XXXXXX", err[512], want[600];
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    write_file(path, text);
+    cal_series s;
+    assert_int_equal(cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err), 1);
+    snprintf(want, sizeof want, "%s:%d: %s", path, line, field);
+    if (!strstr(err, want)) fail_msg("expected '%s' in: %s", want, err);
+    assert_null(s.points);
+    unlink(path);
+}
+
+static void test_bad_csv_named_by_line_and_field(void **state)
+{
+    (void)state;
+    const char *header = "surface,rpm,csa_percent,csa_sd_percent\n";
+    char text[512];
+    expect_csv_error("", 1, "header");                                      // empty
+    expect_csv_error("# only a comment\n", 1, "header");
+    expect_csv_error("surface,rpm,angle_deg,angle_sd_deg\nPP,4,30,1\n", 1, "header"); // wrong columns
+    snprintf(text, sizeof text, "%sPP,4,45\n", header), expect_csv_error(text, 2, "row");        // 3 fields
+    snprintf(text, sizeof text, "%sPP,4,45,1,9\n", header), expect_csv_error(text, 2, "row");    // 5 fields
+    snprintf(text, sizeof text, "%sPP,four,45,1\n", header), expect_csv_error(text, 2, "rpm");   // text in a number
+    snprintf(text, sizeof text, "%s# c\nPP,4,nan,1\n", header), expect_csv_error(text, 3, "csa_percent"); // NaN
+    snprintf(text, sizeof text, "%sPP,-4,45,1\n", header), expect_csv_error(text, 2, "rpm");     // negative rpm
+    snprintf(text, sizeof text, "%sPP,4,145,1\n", header), expect_csv_error(text, 2, "csa_percent"); // > 100 %
+    snprintf(text, sizeof text, "%sPP,4,45,-1\n", header), expect_csv_error(text, 2, "csa_sd_percent");
+    snprintf(text, sizeof text, "%s,4,45,1\n", header), expect_csv_error(text, 2, "surface");   // empty name
+    snprintf(text, sizeof text, "%sPP,4,45,1\nPP,4,46,1\n", header), expect_csv_error(text, 3, "surface"); // duplicate
+    snprintf(text, sizeof text, "%s\"PP,4,45,1\n", header), expect_csv_error(text, 2, "row");   // unterminated quote
+    snprintf(text, sizeof text, "%sPP,4,45", header), expect_csv_error(text, 2, "row");         // truncated
+    expect_csv_error(header, 1, "row");                                      // no data
+    snprintf(text, sizeof text, "%sPP,4,1e999,1\n", header), expect_csv_error(text, 2, "csa_percent"); // overflow
+}
+
+static void test_quoted_and_commented_csv_reads(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/granucal_csv_XXXXXX", err[512];
+    close(mkstemp(path));
+    write_file(path, "# lab, 2024\nsurface,rpm,csa_percent,csa_sd_percent\n\"spray-dried, fine\",4,45.5,0.5\r\nPP,40,44,0\n");
+    cal_series s;
+    if (cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(s.count, 2);
+    assert_string_equal(s.points[0].surface, "spray-dried, fine");
+    assert_int_equal(s.points[0].line, 3);
+    assert_true(s.points[1].rpm == 40 && s.points[1].value == 44);
+    cal_series_free(&s);
+    unlink(path);
+}
+
+static void test_shipped_config_loads(void **state)
+{
+    (void)state;
+    char path[1200], err[1024];
+    snprintf(path, sizeof path, "%s/configs/calibration.yaml", source);
+    cal_config *c = cal_config_load(path, NULL, err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    assert_non_null(cal_config_tier(c));
+    assert_int_equal(c->materials_count, 3);
+    cal_config_free(c);
+    c = cal_config_load(path, "ci", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    assert_string_equal(cal_config_tier(c)->name, "ci");
+    cal_config_free(c);
+    assert_null(cal_config_load(path, "nonesuch", err, sizeof err));
+    assert_non_null(strstr(err, "tier"));
+}
+
+// Replace `from` by `to` in the shipped config and expect an error that names
+// the field and the line where `to` stands.
+static void expect_config_error(const char *from, const char *to, const char *field)
+{
+    char shipped[1200], path[] = "/tmp/granucal_cfg_XXXXXX", err[1024], want[1300];
+    snprintf(shipped, sizeof shipped, "%s/configs/calibration.yaml", source);
+    FILE *f = fopen(shipped, "r");
+    assert_non_null(f);
+    static char text[1 << 16];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    text[n] = '\0';
+    fclose(f);
+    char *at = strstr(text, from);
+    assert_non_null(at);
+    static char edited[1 << 16];
+    snprintf(edited, sizeof edited, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    // The line the field stands on, at or after the edit.
+    const char *leaf = strrchr(field, '.') ? strrchr(field, '.') + 1 : field;
+    const char *mark = strstr(edited + (at - text), leaf);
+    assert_non_null(mark);
+    int line = 1;
+    for (const char *p = edited; p < mark; ++p) line += *p == '\n';
+    close(mkstemp(path));
+    write_file(path, edited);
+    cal_config *c = cal_config_load(path, NULL, err, sizeof err);
+    if (c) fail_msg("accepted %s", to);
+    snprintf(want, sizeof want, "%s:%d: %s", path, line, field);
+    if (!strstr(err, want)) fail_msg("expected '%s' in: %s", want, err);
+    unlink(path);
+}
+
+static void test_bad_config_named_by_line_and_field(void **state)
+{
+    (void)state;
+    expect_config_error("xi: 0.7", "xi: -0.7", "xi");
+    expect_config_error("xi: 0.7", "xi: seven", "xi");                      // text in a number
+    expect_config_error("fill: 0.43", "fill: 1.43", "fill");                // fill above 100 %
+    expect_config_error("pour_mu_s: 0.5", "pour_mu_s: -0.5", "pour_mu_s");  // negative friction
+    expect_config_error("granule_mu_r: 0.2", "granule_mu_r: -1", "granule_mu_r");
+    expect_config_error("mu_s_min: 0.1, mu_s_max: 1.0, mu_r_min: 0.001", "mu_s_min: 0.1, mu_s_max: 1.0, mu_r_min: 0",
+                        "granule.mu_r_min");                                // log scale needs > 0
+    expect_config_error("density: 1800", "density: 1800\nviscosity: 3", "viscosity"); // unknown key
+    expect_config_error("tier: quick", "tier: fast", "tier");               // unknown tier
+    expect_config_error("damping: approaching", "damping: sometimes", "damping");
+    expect_config_error("stiffness: [25, 50", "stiffness: [50, 25", "stiffness"); // not increasing
+    expect_config_error("max_evaluations: 4\n    angle_sd_deg: 2.0\n  # ci", "max_evaluations: -4\n    angle_sd_deg: 2.0\n  # ci",
+                        "max_evaluations");                                 // in a tier's own block
+}
+
+static void test_store_round_trip_and_collision_check(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/granucal_store_XXXXXX", err[512];
+    assert_non_null(mkdtemp(dir));
+    cal_record r = {.key = "drum rpm=4 it's: a key", .status = "not steady", .reason = "line\nbreak 'quoted'",
+                    .angle_deg = 34.56789012345678, .csa_percent = 45.5, .steady = 0, .granules = 566,
+                    .particle_steps = 1.25e9};
+    cal_record back;
+    assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), 1); // absent
+    assert_int_equal(cal_store_put(dir, &r, err, sizeof err), 0);
+    assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), 0);
+    assert_string_equal(back.key, r.key);
+    assert_string_equal(back.status, "not steady");
+    assert_string_equal(back.reason, "line break 'quoted'");
+    assert_true(back.angle_deg == r.angle_deg && back.particle_steps == r.particle_steps && back.granules == 566);
+    assert_true(cal_record_usable(&back));
+    cal_record_free(&back);
+    // A record whose key differs from the one asked for (a collision, or a
+    // file copied by hand) is refused, not silently used.
+    char path[1200], other[1200];
+    cal_store_path(dir, r.key, path, sizeof path);
+    cal_record r2 = r;
+    r2.key = "another simulation";
+    assert_int_equal(cal_store_put(dir, &r2, err, sizeof err), 0);
+    cal_store_path(dir, r2.key, other, sizeof other);
+    assert_int_equal(rename(other, path), 0);
+    assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
+    assert_non_null(strstr(err, "different simulation"));
+    // A damaged record is an error naming the file, not a crash.
+    write_file(path, "key: 'x\nstatus: [\n");
+    assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
+    assert_non_null(strstr(err, path));
+    unlink(path);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const char *s = getenv("GRANUCAL_SOURCE_DIR");
+    snprintf(source, sizeof source, "%s", s ? s : ".");
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_shipped_angles_are_table_2),
+        cmocka_unit_test(test_bad_csv_named_by_line_and_field),
+        cmocka_unit_test(test_quoted_and_commented_csv_reads),
+        cmocka_unit_test(test_shipped_config_loads),
+        cmocka_unit_test(test_bad_config_named_by_line_and_field),
+        cmocka_unit_test(test_store_round_trip_and_collision_check),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
