@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# A small calibration (the PTFE wall alone, tier `check`) run on one process and with
+# `mpirun -np 2` gives the same table and the same measurement in every record.
+#   usage: mpi_same_table.sh GRANUCAL SOURCE_DIR WORK_DIR
+set -euo pipefail
+bin=$1 src=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+cd "$src"
+args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 1)
+"$bin" "${args[@]}" --out "$work/serial" > "$work/serial.log" 2>&1 || { cat "$work/serial.log"; exit 1; }
+mpi=(mpirun -np 2)
+[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+"${mpi[@]}" --oversubscribe "$bin" "${args[@]}" --out "$work/mpi" > "$work/mpi.log" 2>&1 || { cat "$work/mpi.log"; exit 1; }
+diff "$work/serial/calibrated_parameters.csv" "$work/mpi/calibrated_parameters.csv"
+# Every simulation's measurement (wall time aside) is the same whichever rank ran it.
+strip() { cut -d, -f1-15,17- "$1"; }
+diff <(strip "$work/serial/simulations.csv") <(strip "$work/mpi/simulations.csv")
+n=$(($(wc -l < "$work/serial/simulations.csv") - 1))
+grep -q "2 rank(s)" "$work/mpi/report.md" || { echo "the MPI run did not see 2 ranks"; exit 1; }
+echo "same table and the same $n simulations from 1 process and from 2 MPI ranks"

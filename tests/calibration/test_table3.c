@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: MIT
+// Table 3 in CI: run `granucal calibrate --tier ci` end to end on the shipped
+// lab data (stiffness, granule–granule, then aluminium, PP and PTFE), print
+// the calibrated table beside the paper's Table 3 with the deviation of every
+// entry, and fail where an entry is outside its stated tolerance.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+typedef struct entry {
+    char contact[24], material[32], parameter[16];
+    double value;
+} entry;
+
+/// How far an entry may be from the paper's, and why.
+typedef struct tolerance {
+    const char *contact, *material, *parameter;
+    int log_scale;     ///< compare log10 of the values (the wall mu_r spans decades)
+    double allowed;    ///< |calibrated - paper| (or |log10 ratio|)
+    const char *reason;
+} tolerance;
+
+#include "table3_tolerances.h"
+
+static int read_table(const char *path, entry *out, int cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) fail_msg("cannot open %s", path);
+    char line[256];
+    int n = 0;
+    if (!fgets(line, sizeof line, f)) fail_msg("%s: empty", path);
+    while (n < cap && fgets(line, sizeof line, f)) {
+        entry *e = &out[n];
+        char *fields[5], *p = line;
+        for (int k = 0; k < 5; ++k) fields[k] = strsep(&p, ",");
+        if (!fields[4]) fail_msg("%s: malformed line '%s'", path, line);
+        snprintf(e->contact, sizeof e->contact, "%s", fields[0]);
+        snprintf(e->material, sizeof e->material, "%s", fields[1]);
+        snprintf(e->parameter, sizeof e->parameter, "%s", fields[2]);
+        e->value = strtod(fields[3], NULL);
+        n++;
+    }
+    fclose(f);
+    return n;
+}
+
+static const entry *find(const entry *t, int n, const entry *like)
+{
+    for (int i = 0; i < n; ++i)
+        if (!strcmp(t[i].contact, like->contact) && !strcmp(t[i].material, like->material) &&
+            !strcmp(t[i].parameter, like->parameter))
+            return &t[i];
+    return NULL;
+}
+
+static const tolerance *tolerance_of(const entry *e)
+{
+    for (size_t k = 0; k < sizeof tolerances / sizeof *tolerances; ++k) {
+        const tolerance *t = &tolerances[k];
+        if (!strcmp(t->contact, e->contact) && !strcmp(t->parameter, e->parameter) &&
+            (!strcmp(t->material, "*") || !strcmp(t->material, e->material)))
+            return t;
+    }
+    return NULL;
+}
+
+static void test_table3_reproduced(void **state)
+{
+    (void)state;
+    const char *src = getenv("GRANUCAL_SOURCE_DIR"), *bin = getenv("GRANUCAL_BINARY_DIR");
+    assert_non_null(src), assert_non_null(bin);
+    char cmd[4096], path[1200];
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s/granucal' calibrate configs/calibration.yaml --tier ci --out '%s/table3'",
+             src, bin, bin);
+    printf("running: %s\n", cmd);
+    fflush(stdout);
+    int status = system(cmd);
+    assert_int_equal(status, 0);
+    entry paper[64], ours[64];
+    snprintf(path, sizeof path, "%s/results/paper_table3.csv", src);
+    int n_paper = read_table(path, paper, 64);
+    snprintf(path, sizeof path, "%s/table3/calibrated_parameters.csv", bin);
+    int n_ours = read_table(path, ours, 64);
+    assert_int_equal(n_ours, n_paper);
+    printf("\n%-17s %-10s %-9s %12s %12s %12s %9s  %s\n", "contact", "material", "parameter", "paper", "calibrated",
+           "deviation", "allowed", "verdict");
+    int outside = 0;
+    for (int i = 0; i < n_paper; ++i) {
+        const entry *o = find(ours, n_ours, &paper[i]);
+        const tolerance *t = tolerance_of(&paper[i]);
+        if (!o || !t) fail_msg("no %s %s %s in the calibrated table or no tolerance for it", paper[i].contact,
+                               paper[i].material, paper[i].parameter);
+        double dev = t->log_scale ? log10(o->value / paper[i].value) : o->value - paper[i].value;
+        int ok = fabs(dev) <= t->allowed;
+        outside += !ok;
+        printf("%-17s %-10s %-9s %12.5g %12.5g %+11.3g%s %9.3g  %s\n", paper[i].contact, paper[i].material,
+               paper[i].parameter, paper[i].value, o->value, dev, t->log_scale ? "d" : " ", t->allowed,
+               ok ? "ok" : "OUTSIDE");
+    }
+    printf("(d: decades, log10 of calibrated/paper)\n\nTolerances:\n");
+    for (size_t k = 0; k < sizeof tolerances / sizeof *tolerances; ++k)
+        printf("  %s %s %s: %g%s — %s\n", tolerances[k].contact, tolerances[k].material, tolerances[k].parameter,
+               tolerances[k].allowed, tolerances[k].log_scale ? " decades" : "", tolerances[k].reason);
+    assert_int_equal(outside, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_table3_reproduced)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
