@@ -12,6 +12,9 @@ build=${1:-build}
 out=results/runs/synthetic_csa
 rpms=4,40,80,105,116
 mkdir -p "$out"
+# One thread per simulation: two run side by side, and OpenMP threads spinning at barriers
+# on a shared, oversubscribed machine slow a run down by orders of magnitude.
+export OMP_NUM_THREADS=1
 run() { # lining surface-name
   "$build/granucal" simulate configs/drum.yaml --set wall="$1" --set max_time=4 --rpm-list "$rpms" \
     --out "$out/$1" > "$out/$1.json" 2> "$out/$1.log"
