@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash .ci/setup
-ctest --test-dir build --output-on-failure -j1
+# Table 3 end to end (label table3) joins when its tolerances are measured (issue 5; README).
+ctest --test-dir build --output-on-failure -j1 -LE table3
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DGRANUCAL_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$(nproc)" >/dev/null
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \

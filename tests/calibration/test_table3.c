@@ -38,12 +38,16 @@ static int read_table(const char *path, entry *out, int cap)
     if (!fgets(line, sizeof line, f)) fail_msg("%s: empty", path);
     while (n < cap && fgets(line, sizeof line, f)) {
         entry *e = &out[n];
-        char *fields[5], *p = line;
-        for (int k = 0; k < 5; ++k) fields[k] = strsep(&p, ",");
+        char *fields[5] = {0}, *p = line;
+        for (int k = 0; k < 5 && p; ++k) { // comma-separated, empty fields kept
+            fields[k] = p;
+            p = strchr(p, ',');
+            if (p) *p++ = '\0';
+        }
         if (!fields[4]) fail_msg("%s: malformed line '%s'", path, line);
-        snprintf(e->contact, sizeof e->contact, "%s", fields[0]);
-        snprintf(e->material, sizeof e->material, "%s", fields[1]);
-        snprintf(e->parameter, sizeof e->parameter, "%s", fields[2]);
+        snprintf(e->contact, sizeof e->contact, "%.23s", fields[0]);
+        snprintf(e->material, sizeof e->material, "%.31s", fields[1]);
+        snprintf(e->parameter, sizeof e->parameter, "%.15s", fields[2]);
         e->value = strtod(fields[3], NULL);
         n++;
     }

@@ -1,0 +1,283 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Issue 7: granucal against LIGGGHTS 3.8 and LAMMPS on the same 40 rpm drum
+# slice (Table 3 granule–granule parameters), same granules, same step, same
+# number of steps. Not a pass/fail test: it prints a table and, as its LAST
+# line, `granucal_per_core_vs_liggghts=X granucal_per_core_vs_lammps=Y`.
+#
+#   tests/bench/vs_peers.sh [--quick] [--reps R] [--scale S] [--out DIR] [--rebuild]
+#
+#   --quick   N = 5 000 and 20 000 only, 2 repetitions, short stability scan (~ minutes)
+#   --reps R  repetitions of each A B C triple (default 3; medians are quoted)
+#   --scale S multiply every step count by S (default 1)
+#   --out DIR where raw.csv and the log go (default build-bench/vs_peers)
+#   --rebuild rebuild the settled beds even if they exist
+#   --worktree build granucal from the work tree as it is (default: HEAD)
+#
+# Order: for each N and thread count, granucal, LIGGGHTS, LAMMPS, repeated R
+# times (A B C A B C ...), so the shared machine's noise hits all three alike;
+# ratios are formed within each repetition and their median is quoted.
+# Threads: granucal OpenMP threads; LIGGGHTS and LAMMPS MPI ranks (their
+# granular pair styles have no OpenMP variant in these packages).
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+BUILD=${BUILD:-$ROOT/build-bench}
+ARGS="$*"
+QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) QUICK=1; REPS=2 ;;
+    --reps) REPS=$2; shift ;;
+    --scale) SCALE=$2; shift ;;
+    --out) OUT=$2; shift ;;
+    --rebuild) REBUILD=1 ;;
+    --worktree) WORKTREE=1 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+OUT=${OUT:-$BUILD/vs_peers}
+mkdir -p "$OUT"
+BEDS=$BUILD/peers
+mkdir -p "$BEDS"
+PEERS=$ROOT/tests/bench/peers
+
+# ---- peers: Debian packages liggghts (binary liggghts) and lammps (binary lmp)
+need=()
+command -v liggghts >/dev/null || need+=(liggghts)
+command -v lmp >/dev/null || need+=(lammps)
+command -v mpirun >/dev/null || need+=(openmpi-bin)
+[ -x /usr/bin/time ] || need+=(time)
+if [ ${#need[@]} -gt 0 ]; then
+  echo "installing ${need[*]}" >&2
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}" >&2
+fi
+MPIRUN=(mpirun --oversubscribe --bind-to none)
+[ "$(id -u)" -eq 0 ] && MPIRUN+=(--allow-run-as-root)
+
+# ---- granucal's bench. By default from a clean export of HEAD (others edit
+# engine/ in the shared work tree; a benchmark names one commit), with this
+# work tree's bench_drum_peers.c on top; --worktree builds the tree as it is.
+if [ $WORKTREE -eq 1 ]; then
+  SRC=$ROOT; OBJ=$BUILD; GRANUCAL_SRC="work tree"
+else
+  SRC=$BUILD/src; OBJ=$BUILD/obj
+  rm -rf "$SRC" && mkdir -p "$SRC"
+  git -C "$ROOT" archive HEAD | tar -x -C "$SRC"
+  cp "$ROOT/tests/bench/bench_drum_peers.c" "$SRC/tests/bench/"
+  GRANUCAL_SRC="git archive HEAD + work-tree bench_drum_peers.c$(git -C "$ROOT" diff --quiet HEAD -- tests/bench/bench_drum_peers.c 2>/dev/null || echo ' (modified)')"
+fi
+cmake -S "$SRC" -B "$OBJ" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$OBJ" -j2 --target bench_drum_peers >/dev/null
+BENCH=$OBJ/tests/bench_drum_peers
+
+# ---- settled beds: N = 5 000 settled once; 20 000 and 100 000 are the same
+# periodic slab repeated 4 and 20 times along the drum axis (same λ, same step).
+if [ $REBUILD -eq 1 ] || [ ! -f "$BEDS/drum_5000.vars" ] || [ ! -f "$BEDS/drum_100000.vars" ]; then
+  echo "building the settled beds (once) ..." >&2
+  "$BENCH" build 5000 "$BEDS" 4 20 2> "$OUT/build_beds.log"
+fi
+if [ $QUICK -eq 1 ]; then SIZES="5000 20000"; else SIZES="5000 20000 100000"; fi
+steps_for() { # ~5e6 particle-steps per run (x --scale)
+  case $1 in 5000) s=1000 ;; 20000) s=250 ;; *) s=60 ;; esac
+  [ $QUICK -eq 1 ] && s=$((s / 2))
+  python3 -c "print(max(10, int($s * $SCALE)))"
+}
+vars() { (set +u; . "$BEDS/drum_$1.vars"; eval echo "\$$2"); }
+
+RAW=$OUT/raw.csv
+LOG=$OUT/runs.log
+echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
+: > "$LOG"
+
+# run_granucal N THREADS REP VARIANT STEPS DT [RPM [allow]]
+run_granucal() {
+  local n=$1 th=$2 rep=$3 var=$4 steps=$5 dt=$6 rpm=${7:-40} allow=${8:-}
+  local line
+  line=$(OMP_NUM_THREADS=$th OMP_PROC_BIND=false "$BENCH" run "$BEDS/drum_$n.data" "$steps" "$th" "$var" "$dt" "$rpm" $allow 2>>"$LOG") || true
+  if [ -z "$line" ]; then
+    echo "granucal,$n,$th,$rep,$var,$steps,$dt,,,,failed,,,,,," >> "$RAW"; return
+  fi
+  # bench: code,N,threads,variant,steps,dt,loop_s,psps,maxrss,angle0,csa0,angle1,csa1,ke0,ke1,coord,checksum,status
+  echo "$line" | awk -F, -v rep="$rep" '{st=$18; gsub(/,/,";",st); printf "granucal,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n",$2,$3,rep,$4,$5,$6,$7,$8,$9,(st=="ok"?"ok":"fault"),$10,$11,$12,$13,$17,$15}' >> "$RAW"
+}
+
+# run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO
+run_peer() {
+  local code=$1 n=$2 np=$3 rep=$4 steps=$5 dt=$6 omega=$7 nthermo=$8
+  local log=$OUT/${code}_${n}_${np}_${rep}.log tf=$OUT/time.txt status=ok
+  local common=(-var data "$BEDS/drum_$n.data" -var dt "$dt" -var steps "$steps" -var nthermo "$nthermo"
+                -var rdrum "$(vars "$n" RDRUM)" -var omega "$omega" -var skin "$(vars "$n" SKIN)")
+  if [ "$code" = liggghts ]; then
+    /usr/bin/time -f "%M" -o "$tf" "${MPIRUN[@]}" -np "$np" liggghts -in "$PEERS/drum_liggghts.in" -echo none -screen none \
+      -log "$log" "${common[@]}" -var coeffs "$BEDS/drum_$n.liggghts.coeffs" >>"$LOG" 2>&1 || status=failed
+  else
+    /usr/bin/time -f "%M" -o "$tf" "${MPIRUN[@]}" -np "$np" lmp -in "$PEERS/drum_lammps.in" -echo none -screen none \
+      -log "$log" "${common[@]}" -var coeffs "$BEDS/drum_$n.lammps.coeffs" -var kw "$(vars "$n" KW)" \
+      -var etawall "$(vars "$n" ETA_WALL)" -var mu "$(vars "$n" MU)" -var mur "$(vars "$n" MUR)" >>"$LOG" 2>&1 || status=failed
+  fi
+  local loop atoms ke
+  loop=$(awk '/^Loop time of/ {print $4}' "$log" 2>/dev/null | tail -1)
+  atoms=$(sed -n 's/^Loop time of .* with \([0-9]*\) atoms.*/\1/p' "$log" 2>/dev/null | tail -1)
+  # last thermo line before "Loop time": step atoms ke rke
+  ke=$(awk '/^Loop time of/ {print prev} {if ($1 ~ /^[0-9]+$/ && NF >= 4) prev = $3 + $4}' "$log" 2>/dev/null | tail -1)
+  [ -z "$loop" ] && status=failed
+  local psps=""
+  [ -n "$loop" ] && psps=$(python3 -c "print('%.5g' % ($atoms * $steps / $loop))")
+  echo "$code,$n,$np,$rep,all,$steps,$dt,$loop,$psps,$(tail -1 "$tf" 2>/dev/null),$status,,,,,,$ke" >> "$RAW"
+}
+
+N0=5000
+DTC=$(vars $N0 DT_CRIT)
+DT_G=$(vars $N0 DT_APRIORI)
+DT_NET=$(vars $N0 DT_NETWORK)
+echo "machine: $(lscpu | awk -F: '/Model name/ {gsub(/^ +/, "", $2); print $2}'), $(nproc) cores; load $(cut -d' ' -f1-3 /proc/loadavg)" | tee "$OUT/machine.txt"
+echo "commit: $(git -C "$ROOT" rev-parse --short HEAD); granucal built from: $GRANUCAL_SRC" | tee -a "$OUT/machine.txt"
+echo "command: tests/bench/vs_peers.sh $ARGS" | tee -a "$OUT/machine.txt"
+
+# ---- 1. largest step each code keeps a dense bed at rest (N = 5 000, drum still)
+# A step is kept if the run completes, nothing is lost and the kinetic energy
+# at the end is below 1e-3 of (bed mass)·g·d50 (the bed was built at rest).
+SCAN_STEPS=$([ $QUICK -eq 1 ] && echo 1500 || echo 3000)
+FACTORS=$([ $QUICK -eq 1 ] && echo "0.6 0.35" || echo "0.6 0.45 0.35 0.25")
+BEDMASS=$(vars $N0 BED_MASS); D50=$(vars $N0 D50)
+echo "stability scan: N=$N0, drum at rest, $SCAN_STEPS steps, 1 thread/rank, dt_crit = $DTC s" >&2
+for f in $FACTORS; do
+  dt=$(python3 -c "print('%.6g' % ($f * $DTC))")
+  run_granucal $N0 1 "scan$f" all $SCAN_STEPS "$dt" 0 allow
+  run_peer liggghts $N0 1 "scan$f" $SCAN_STEPS "$dt" 0 $SCAN_STEPS
+  run_peer lammps $N0 1 "scan$f" $SCAN_STEPS "$dt" 0 $SCAN_STEPS
+done
+# granucal at the step its engine picks for a settled bed (network step)
+run_granucal $N0 1 scannet all $SCAN_STEPS "$DT_NET" 0
+
+# ---- 2. timing at one common step: granucal's a-priori step, or less if a
+# peer needs less (from the scan) so all three integrate the same stable run.
+DT=$(python3 - "$RAW" "$DTC" "$DT_G" "$BEDMASS" "$D50" <<'EOF'
+import csv, sys
+raw, dtc, dtg, mass, d50 = sys.argv[1], *map(float, sys.argv[2:])
+best = {}
+for r in csv.DictReader(open(raw)):
+    if not r['rep'].startswith('scan') or r['rep'] == 'scannet': continue
+    f = float(r['rep'][4:])
+    ke = r['ke_end']
+    if r['code'] == 'granucal': ok = r['status'] == 'ok' and ke != '' and float(ke) < 1e-3
+    else: ok = r['status'] == 'ok' and ke not in ('', 'nan', '-nan') and float(ke) / (mass * 9.81 * d50) < 1e-3
+    if ok: best[r['code']] = max(best.get(r['code'], 0), f)
+peer = min(best.get('liggghts', 0.25), best.get('lammps', 0.25))
+print('%.6g' % min(dtg, peer * dtc))
+EOF
+)
+echo "timing step: dt = $DT s ($(python3 -c "print('%.3f' % ($DT / $DTC))") dt_crit); granucal a priori $DT_G s" | tee -a "$OUT/machine.txt"
+
+for n in $SIZES; do
+  steps=$(steps_for "$n")
+  for th in 1 2; do
+    for rep in $(seq 1 "$REPS"); do
+      echo "N=$n threads=$th rep $rep/$REPS ($steps steps)" >&2
+      run_granucal "$n" "$th" "$rep" all "$steps" "$DT"
+      run_peer liggghts "$n" "$th" "$rep" "$steps" "$DT" "$(vars "$n" OMEGA)" "$steps"
+      run_peer lammps "$n" "$th" "$rep" "$steps" "$DT" "$(vars "$n" OMEGA)" "$steps"
+      if [ "$n" = 20000 ]; then # what each effect costs, in the same alternation
+        run_granucal "$n" "$th" "$rep" norolling "$steps" "$DT"
+        run_granucal "$n" "$th" "$rep" notangential "$steps" "$DT"
+      fi
+    done
+  done
+done
+
+# ---- 3. table, 1 s of drum, accuracy guard, final line
+python3 - "$RAW" "$BEDS" "$DTC" "$DT_NET" "$BEDMASS" "$D50" <<'EOF'
+import csv, statistics as st, sys
+raw, beds = sys.argv[1], sys.argv[2]
+dtc, dtnet, mass, d50 = map(float, sys.argv[3:])
+rows = list(csv.DictReader(open(raw)))
+med = lambda xs: st.median(xs) if xs else float('nan')
+def sel(**kw): return [r for r in rows if all(r[k] == v for k, v in kw.items())]
+def num(x):
+    try: return float(x)
+    except ValueError: return float('nan')
+
+print("\n== stability scan (N = 5000, drum at rest): kinetic energy at the end / (bed mass g d50)")
+scan = {}
+for r in rows:
+    if not r['rep'].startswith('scan'): continue
+    ke = num(r['ke_end'])
+    if r['code'] != 'granucal': ke /= mass * 9.81 * d50
+    f = dtnet / dtc if r['rep'] == 'scannet' else float(r['rep'][4:])
+    ok = r['status'] == 'ok' and ke == ke and ke < 1e-3
+    if ok: scan[r['code']] = max(scan.get(r['code'], 0), f)
+    print("  %-9s dt = %.3f dt_crit: %-6s KE ratio %.2e -> %s" % (r['code'], f, r['status'], ke, 'at rest' if ok else 'NOT at rest'))
+
+print("\n== timing (medians of %s repetitions; ratio = granucal/peer, formed per repetition)" % max(
+    [int(r['rep']) for r in rows if r['rep'].isdigit()] or [0]))
+print("%-9s %7s %3s %6s %14s %9s %10s %14s %14s" % ("code", "N", "thr", "steps", "p-steps/s", "wall s", "peak MiB",
+                                                    "vs liggghts", "vs lammps"))
+summary = {}
+for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit()}):
+    for th in ('1', '2'):
+        g = {r['rep']: r for r in sel(N=str(n), threads=th, code='granucal', variant='all') if r['rep'].isdigit()}
+        for code in ('granucal', 'liggghts', 'lammps'):
+            rs = [r for r in sel(N=str(n), threads=th, code=code, variant='all') if r['rep'].isdigit() and r['status'] == 'ok']
+            if not rs:
+                print("%-9s %7d %3s  failed" % (code, n, th)); continue
+            ps = med([num(r['psps']) for r in rs]); summary[(code, n, th)] = ps
+            ratios = {}
+            for peer in ('liggghts', 'lammps'):
+                pr = {r['rep']: r for r in sel(N=str(n), threads=th, code=peer, variant='all') if r['status'] == 'ok'}
+                if code == 'granucal':
+                    ratios[peer] = med([num(g[k]['psps']) / num(pr[k]['psps']) for k in g if k in pr and g[k]['status'] == 'ok'])
+            print("%-9s %7d %3s %6s %14.3e %9.2f %10.1f %14s %14s" % (
+                code, n, th, rs[0]['steps'], ps, med([num(r['loop_s']) for r in rs]),
+                med([num(r['maxrss_kib']) for r in rs]) / 1024,
+                "%.2f" % ratios['liggghts'] if 'liggghts' in ratios else "",
+                "%.2f" % ratios['lammps'] if 'lammps' in ratios else ""))
+            if code == 'granucal': summary[('ratio', n, th)] = ratios
+    for th in ('1', '2'):
+        for v in ('norolling', 'notangential'):
+            rs = [r for r in sel(N=str(n), threads=th, code='granucal', variant=v) if r['status'] == 'ok']
+            if rs:
+                al = {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, code='granucal', variant='all')}
+                sp = med([num(r['psps']) / al[r['rep']] for r in rs if r['rep'] in al])
+                print("granucal %-14s N=%d thr=%s: %.3e p-steps/s, %.2fx all effects on" % (
+                    v, n, th, med([num(r['psps']) for r in rs]), sp))
+
+print("\n== wall time to simulate 1 s of the drum at N = 20000, at each code's largest step kept at rest")
+for th in ('1', '2'):
+    for code in ('granucal', 'liggghts', 'lammps'):
+        ps = summary.get((code, 20000, th)); f = scan.get(code)
+        if code == 'granucal': f = dtnet / dtc  # the engine's own pick (network step)
+        if ps and f:
+            print("  %-9s %s thr: dt = %.3f dt_crit -> %.0f s per simulated second" % (code, th, f, 20000 / (f * dtc) / ps))
+
+print("\n== accuracy guard (granucal, after the timed steps at 40 rpm)")
+bad = 0
+for r in rows:
+    if r['code'] != 'granucal' or not r['rep'].isdigit() or r['status'] != 'ok': continue
+    c0, c1, a1 = num(r['csa0']), num(r['csa1']), num(r['angle1'])
+    ok = abs(c1 - c0) < 1.0 and 30 < c1 < 55 and a1 < 45
+    bad += not ok
+    if not ok: print("  OUT OF RANGE: N=%s thr=%s %s: CSA %.2f -> %.2f %%, angle %.2f deg" % (r['N'], r['threads'], r['variant'], c0, c1, a1))
+gs = [r for r in rows if r['code'] == 'granucal' and r['rep'].isdigit() and r['variant'] == 'all']
+for n in sorted({r['N'] for r in gs}, key=int):
+    rs = [r for r in gs if r['N'] == n]
+    same = len({r['checksum'] for r in rs}) == 1
+    print("  N=%s: CSA %.2f %% -> %.2f %%, angle %.2f -> %.2f deg; final state %s for 1 and 2 threads" % (
+        n, num(rs[0]['csa0']), num(rs[0]['csa1']), num(rs[0]['angle0']), num(rs[0]['angle1']),
+        "bitwise identical" if same else "DIFFERENT"))
+print("  %s" % ("all granucal runs within the guard" if bad == 0 else "%d runs out of the guard" % bad))
+
+def pc(code): return [r for r in sel(N='20000', code=code, variant='all') if r['rep'].isdigit() and r['status'] == 'ok']
+def per_core_ratio(peer):
+    out = []
+    for g in pc('granucal'):
+        for p in pc(peer):
+            if p['rep'] == g['rep'] and p['threads'] == g['threads']:
+                out.append((num(g['psps']) / int(g['threads'])) / (num(p['psps']) / int(p['threads'])))
+    return med(out)
+print("\n(per core: particle-steps/s divided by threads or ranks; median over repetitions and 1 and 2 threads, N = 20000)")
+print("granucal_per_core_vs_liggghts=%.2f granucal_per_core_vs_lammps=%.2f" % (per_core_ratio('liggghts'), per_core_ratio('lammps')))
+EOF
