@@ -9,8 +9,10 @@
 #include "cal_commands.h"
 #include "cal_util.h"
 #include "dem_output.h"
+#include "exp_compress.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
+#include "exp_silo.h"
 
 static const char simulate_help[] =
     "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"
@@ -152,6 +154,8 @@ int cal_cmd_simulate(int argc, char **argv)
     }
     if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
     if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out, rpm_list);
+    if (exp_is_compress_config(argv[optind])) return exp_compress_simulate(argv[optind], n_sets, sets, out);
+    if (exp_is_silo_config(argv[optind])) return exp_silo_simulate(argv[optind], n_sets, sets, out);
     if (n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
     char err[1024], dir[1024];
     exp_scene *s = exp_scene_load(argv[optind], err, sizeof err);

@@ -1,0 +1,635 @@
+// SPDX-License-Identifier: MIT
+// The confined compression test (sections 3.2.1, 4.1): pour into the die,
+// strike off, settle, cycle the piston between two pressures, E' (eq. 19).
+#include "exp_compress.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "dem_output.h"
+#include "dem_scaling.h"
+// The engine has no call to translate a wall (its walls are "never moved by
+// the solver"; only a spin can be set). The piston is moved here by writing
+// its plane point between steps, which is all the engine reads of a plane.
+// See move_piston: the one place that touches the engine's private layout.
+#include "dem_world_internal.h"
+#include "exp_plot.h"
+#include "exp_pour.h"
+#include "exp_scene.h"
+
+#define FILL_GRAVITY 1000.0 // pour and settle under 1000 g (see exp_compress_run)
+// exp_ke_ratio divides by (bed mass)·9.81·d50: the thresholds carry the
+// factor FILL_GRAVITY, and a fall under it takes 1/sqrt(FILL_GRAVITY) as long.
+#define LAYER_KE_RATIO (1e-2 * FILL_GRAVITY)
+#define LAYER_MAX_TIME 0.02
+#define SETTLE_KE_RATIO (1e-6 * FILL_GRAVITY)
+#define SETTLE_MAX_TIME 0.03
+#define WALL_SIDE 0
+#define WALL_FLOOR 1
+#define WALL_PISTON 2
+#define SAMPLE_STRAIN 2e-5 // piston travel between samples, over the die depth
+
+exp_compress_def exp_default_compress_def(void)
+{
+    exp_compress_def d;
+    memset(&d, 0, sizeof d);
+    d.diameter = 0.076, d.depth = 0.015; // section 3.2.1
+    d.lambda = 4096;
+    d.gsd = dem_default_gsd();
+    d.density = 1800;
+    d.granule = dem_default_world_def().granule;
+    d.granule.mu_r = 0; // no rolling resistance in this scene
+    d.wall = d.granule;
+    d.wall.mu_s = 0.2; // section 4.1: granule–boundary friction 0.2
+    d.sigma_min = 20, d.sigma_max = 60;
+    d.piston_speed = 0.02;
+    d.cycles = 4;
+    d.max_time = 2.0;
+    d.seed = 1;
+    return d;
+}
+
+int exp_compress_check(const exp_compress_def *d, char *msg, size_t len)
+{
+    char sub[256];
+    if (!(d->diameter > 0)) return exp_fail(msg, len, "diameter = %g: must be > 0", d->diameter);
+    if (!(d->depth > 0)) return exp_fail(msg, len, "depth = %g: must be > 0", d->depth);
+    if (!(d->density > 0)) return exp_fail(msg, len, "density = %g: must be > 0", d->density);
+    if (!(d->sigma_min > 0)) return exp_fail(msg, len, "sigma_min = %g: must be > 0", d->sigma_min);
+    if (!(d->sigma_max > d->sigma_min))
+        return exp_fail(msg, len, "sigma_max = %g: must be > sigma_min (%g)", d->sigma_max, d->sigma_min);
+    if (!(d->piston_speed > 0)) return exp_fail(msg, len, "piston_speed = %g: must be > 0", d->piston_speed);
+    if (d->cycles < 2 || d->cycles > EXP_COMPRESS_MAX_CYCLES)
+        return exp_fail(msg, len, "cycles = %d: must be in [2, %d]", d->cycles, EXP_COMPRESS_MAX_CYCLES);
+    if (!(d->max_time > 0)) return exp_fail(msg, len, "max_time = %g: must be > 0", d->max_time);
+    if (d->granule.mu_r != 0 || d->wall.mu_r != 0)
+        return exp_fail(msg, len, "mu_r = %g: the compression test has no rolling resistance (must be 0)",
+                        d->granule.mu_r != 0 ? d->granule.mu_r : d->wall.mu_r);
+    if (dem_scale_check(d->lambda, sub, sizeof sub)) return exp_fail(msg, len, "%s", sub);
+    if (dem_gsd_check(&d->gsd, sub, sizeof sub)) return exp_fail(msg, len, "%s", sub);
+    if (dem_contact_params_check(&d->granule, sub, sizeof sub)) return exp_fail(msg, len, "granule_contact.%s", sub);
+    if (dem_contact_params_check(&d->wall, sub, sizeof sub)) return exp_fail(msg, len, "wall_contact.%s", sub);
+    double dmax = dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda);
+    if (d->depth < 2 * dmax || d->diameter < 4 * dmax)
+        return exp_fail(msg, len, "lambda = %g: the largest scaled granule (%.3g m) does not fit the die twice", d->lambda,
+                        dmax);
+    return 0;
+}
+
+void exp_compress_result_free(exp_compress_result *r)
+{
+    if (r) free(r->curve), r->curve = NULL, r->n_curve = 0;
+}
+
+// ----------------------------------------------------------------- the die
+
+static dem_world *create_die(const exp_compress_def *d, double gravity, char *err, size_t len)
+{
+    double r = 0.5 * d->diameter;
+    dem_world_def def = dem_default_world_def();
+    def.gravity = dem_v3(0, -gravity, 0);
+    def.granule = dem_scale_contact(&d->granule, d->lambda);
+    def.domain_lo = dem_v3(-1.2 * r, -0.01, -1.2 * r);
+    def.domain_hi = dem_v3(1.2 * r, 4 * d->depth, 1.2 * r);
+    dem_world *w = dem_world_create(&def, err, len);
+    if (!w) return NULL;
+    dem_contact_params wall = d->wall;
+    wall.k_n = wall.k_s = wall.k_r = 2 * d->granule.k_n; // Table 3: springs in series
+    wall = dem_scale_contact(&wall, d->lambda);
+    dem_wall_def side = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 1, 0}, .radius = r,
+                         .contact = wall, .name = "die"};
+    dem_wall_def floor = {.kind = DEM_WALL_PLANE, .point = {0, 0, 0}, .normal = {0, 1, 0}, .axis = {0, 1, 0},
+                          .contact = wall, .name = "floor"};
+    // The piston waits above the pour, facing down.
+    dem_wall_def piston = {.kind = DEM_WALL_PLANE, .point = {0, 3.5 * d->depth, 0}, .normal = {0, -1, 0},
+                           .axis = {0, 1, 0}, .contact = wall, .name = "piston"};
+    if (dem_world_add_wall(w, &side) != WALL_SIDE || dem_world_add_wall(w, &floor) != WALL_FLOOR ||
+        dem_world_add_wall(w, &piston) != WALL_PISTON) {
+        exp_fail(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
+    return w;
+}
+
+static void move_piston(dem_world *w, double y) { w->walls[WALL_PISTON].def.point.y = y; }
+
+// exp_run_until_rest checks every 0.05 s, longer than a whole layer takes
+// to land under FILL_GRAVITY: the same test every 2 ms.
+static int run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
+                          const char *phase)
+{
+    for (double t = 0; t < max_time; t += 0.002) {
+        if (exp_run_for(w, 0.002, progress, ctx, phase)) return 1;
+        if (exp_ke_ratio(w, d50) < ratio) break;
+    }
+    return 0;
+}
+
+static int inside_die(dem_vec3 p, const void *ctx)
+{
+    double inner = *(const double *)ctx;
+    return p.x * p.x + p.z * p.z <= inner * inner;
+}
+
+// Pour in layers until the bed surface passes the rim; keep the granules
+// whose centres lie below it (the lab strikes the powder off at the rim).
+static int pour_to_rim(dem_world *w, const exp_compress_def *d, const dem_gsd *gsd, exp_progress_fn progress,
+                       void *ctx, char *err, size_t len)
+{
+    double r = 0.5 * d->diameter, pitch = 1.05 * dem_gsd_max_diameter(gsd), inner = r - 0.55 * pitch;
+    size_t cap = 3 * dem_gsd_count_for_volume(gsd, 0.6 * DEM_PI * r * r * d->depth) + 16, next = 0;
+    double *diam = malloc(cap * sizeof *diam);
+    if (!diam || dem_gsd_sample(gsd, d->seed, cap, diam)) return free(diam), exp_fail(err, len, "cannot sample sizes");
+    exp_pour_region region = {dem_v3(-inner, 0, -inner), dem_v3(inner, 2 * d->depth, inner), inside_die, &inner};
+    double rho = dem_scale_density(d->density, d->lambda);
+    while (exp_bed_surface(w, 0) < d->depth) {
+        size_t placed = next < cap ? exp_pour_layer(w, &region, 0, diam, next, cap, pitch, rho) : 0;
+        if (placed == 0) return free(diam), exp_fail(err, len, "compression: ran out of room or sizes while pouring");
+        if (dem_world_prepare(w) != DEM_OK ||
+            run_until_rest(w, gsd->median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
+            return free(diam), exp_fail(err, len, "%s", dem_world_error(w));
+        next += placed;
+    }
+    free(diam);
+    exp_remove_above(w, d->depth);
+    return 0;
+}
+
+// Spring forces on the piston, the floor and the side wall: the normal
+// springs k_n·h of eq. 3 (the dashpot is left out: at the quasi-static rate
+// it is a small, rate-dependent part, see README).
+static void wall_forces(const dem_world *w, const exp_compress_def *d, double piston_y, double *top, double *bottom,
+                        double *side)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double k = dem_scale_stiffness(2 * d->granule.k_n, d->lambda), r_die = 0.5 * d->diameter;
+    double ft = 0, fb = 0, fs = 0;
+    for (size_t i = 0; i < g.count; ++i) {
+        double ri = g.radius[i], y = g.position[i].y;
+        double ht = ri - (piston_y - y), hb = ri - y;
+        double rho = sqrt(g.position[i].x * g.position[i].x + g.position[i].z * g.position[i].z);
+        double hs = ri + rho - r_die;
+        if (ht > 0) ft += k * ht;
+        if (hb > 0) fb += k * hb;
+        if (hs > 0) fs += k * hs;
+    }
+    *top = ft, *bottom = fb, *side = fs;
+}
+
+static double bed_top(const dem_world *w)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double top = 0;
+    for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y + g.radius[i]);
+    return top;
+}
+
+typedef struct curve_buf {
+    exp_compress_sample *s;
+    size_t n, cap;
+} curve_buf;
+
+static int push(curve_buf *c, const exp_compress_sample *s)
+{
+    if (c->n == c->cap) {
+        size_t cap = c->cap ? 2 * c->cap : 4096;
+        exp_compress_sample *p = realloc(c->s, cap * sizeof *p);
+        if (!p) return 1;
+        c->s = p, c->cap = cap;
+    }
+    c->s[c->n++] = *s;
+    return 0;
+}
+
+// Work of the piston on the bed over samples [from, to] (trapezoids of
+// F_top over the piston travel), J; positive when the piston moves down.
+static double piston_work(const exp_compress_sample *s, size_t from, size_t to)
+{
+    double wk = 0;
+    for (size_t k = from; k < to; ++k) wk += 0.5 * (s[k].f_top + s[k + 1].f_top) * (s[k].piston_y - s[k + 1].piston_y);
+    return wk;
+}
+
+// Stable cycle: the permanent strain of the last cycle is below 5 % of its
+// elastic (unloading) strain and its E' is within 5 % of the previous one's.
+static int is_stable(const exp_compress_result *r)
+{
+    if (r->n_cycles < 2) return 0;
+    const exp_compress_cycle *a = &r->cycle[r->n_cycles - 2], *b = &r->cycle[r->n_cycles - 1];
+    double elastic = b->strain_turn - b->strain_end;
+    return fabs(b->permanent_strain) < 0.05 * elastic && fabs(b->e_unloading - a->e_unloading) < 0.05 * b->e_unloading;
+}
+
+// Drive the piston: down until σ ≥ σ_max, up until σ ≤ σ_min, `cycles` times.
+static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn progress, void *ctx,
+                        exp_compress_result *out, char *err, size_t len)
+{
+    double area = DEM_PI * 0.25 * d->diameter * d->diameter, dt = dem_world_dt(w);
+    double step_travel = d->piston_speed * dt;
+    uint64_t per_sample = (uint64_t)(SAMPLE_STRAIN * d->depth / step_travel) + 1;
+    double y = bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda);
+    move_piston(w, y);
+    curve_buf c = {0};
+    int loading = 1, cycle = 1, touched = 0;
+    double h0 = NAN, t0 = dem_world_time(w);
+    size_t turn_at = 0, start_at = 0;
+    unsigned long long steps = 0;
+    exp_compress_cycle *cy = &out->cycle[0];
+    while (1) {
+        for (uint64_t s = 0; s < per_sample; ++s) {
+            y += loading ? -step_travel : step_travel;
+            move_piston(w, y);
+            if (dem_world_step(w, 1) != DEM_OK) return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
+        }
+        steps += per_sample;
+        exp_compress_sample sm = {0};
+        sm.t = dem_world_time(w) - t0;
+        sm.piston_y = y;
+        wall_forces(w, d, y, &sm.f_top, &sm.f_bottom, &sm.f_side);
+        sm.sigma = sm.f_top / area;
+        dem_diagnostics dg = dem_world_diagnose(w);
+        sm.ke_over_elastic = dg.potential_elastic > 0 ? (dg.ke_translational + dg.ke_rotational) / dg.potential_elastic : 0;
+        sm.cycle = cycle, sm.loading = loading;
+        if (isnan(h0) && sm.sigma >= d->sigma_min) {
+            h0 = y; // the bed's height at σ_min: the strain reference (eq. 19)
+            start_at = c.n;
+            touched = 1;
+        }
+        sm.displacement = isnan(h0) ? 0 : h0 - y;
+        sm.strain = isnan(h0) ? 0 : sm.displacement / h0;
+        if (touched) out->max_ke_over_elastic = fmax(out->max_ke_over_elastic, sm.ke_over_elastic);
+        if (push(&c, &sm)) return free(c.s), exp_fail(err, len, "out of memory");
+        if (isnan(h0) && y < 0.3 * d->depth)
+            return free(c.s), exp_fail(err, len, "compression: the piston reached 0.3 of the die depth below sigma_min");
+        if (loading && !isnan(h0) && sm.sigma >= d->sigma_max) {
+            cy->sigma_start = c.s[start_at].sigma, cy->strain_start = c.s[start_at].strain;
+            cy->sigma_turn = sm.sigma, cy->strain_turn = sm.strain;
+            cy->work_in = piston_work(c.s, start_at, c.n - 1);
+            out->coordination_turn = dg.coordination;
+            turn_at = c.n - 1;
+            loading = 0;
+        } else if (!loading && sm.sigma <= d->sigma_min) {
+            cy->sigma_end = sm.sigma, cy->strain_end = sm.strain;
+            cy->work_out = -piston_work(c.s, turn_at, c.n - 1);
+            cy->e_loading = (cy->sigma_turn - cy->sigma_start) / (cy->strain_turn - cy->strain_start); // eq. 19
+            cy->e_unloading = (cy->sigma_turn - cy->sigma_end) / (cy->strain_turn - cy->strain_end);   // eq. 19
+            cy->permanent_strain = cy->strain_end - cy->strain_start;
+            out->n_cycles = cycle;
+            if (cycle == d->cycles) break;
+            cy = &out->cycle[cycle++];
+            start_at = c.n - 1;
+            loading = 1;
+        }
+        if (progress) progress(loading ? "load" : "unload", sm.t, dem_world_granules(w).count, ctx);
+        if (sm.t > d->max_time) break;
+    }
+    out->curve = c.s, out->n_curve = c.n;
+    out->bed_height = h0;
+    out->particle_steps = steps * dem_world_granules(w).count;
+    out->simulated_time_s = dem_world_time(w) - t0;
+    if (out->n_cycles > 0) {
+        out->e_confined = out->cycle[out->n_cycles - 1].e_unloading;
+        out->e_confined_loading = out->cycle[out->n_cycles - 1].e_loading;
+    }
+    out->stable = is_stable(out);
+    return 0;
+}
+
+dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress, void *ctx, exp_compress_result *out,
+                            char *err, size_t len)
+{
+    memset(out, 0, sizeof *out);
+    if (len) err[0] = '\0';
+    if (exp_compress_check(d, err, len)) return NULL;
+    dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
+    // Pour and settle under FILL_GRAVITY·g: a free fall takes as long as in
+    // the lab, while the step, set by sqrt(m/k) (eq. 14) with a coarse granule
+    // keeping a real granule's mass (eq. 16–17), is microseconds: the pour
+    // would be most of the cost. The bed's own weight is then moved into a world with g, where it
+    // is negligible against σ_min (ρ_bulk·g·H ≈ 0.03 Pa at λ = 4096).
+    dem_world *f = create_die(d, FILL_GRAVITY * 9.81, err, len);
+    if (!f) return NULL;
+    if (pour_to_rim(f, d, &gsd, progress, ctx, err, len) ||
+        run_until_rest(f, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
+        if (!err[0]) exp_fail(err, len, "%s", dem_world_error(f));
+        dem_world_destroy(f);
+        return NULL;
+    }
+    out->fill_time_s = dem_world_time(f);
+    dem_world *w = create_die(d, 9.81, err, len);
+    dem_granules_view fg = dem_world_granules(f);
+    for (size_t i = 0; w && i < fg.count; ++i)
+        if (dem_world_add_granule(w, fg.position[i], dem_v3(0, 0, 0), dem_v3(0, 0, 0), fg.radius[i],
+                                  dem_scale_density(d->density, d->lambda)) < 0) {
+            exp_fail(err, len, "%s", dem_world_error(w));
+            dem_world_destroy(w), w = NULL;
+        }
+    dem_world_destroy(f);
+    if (!w) return NULL;
+    out->granules = dem_world_granules(w).count;
+    if (cycle_piston(w, d, progress, ctx, out, err, len)) {
+        dem_world_destroy(w);
+        return NULL;
+    }
+    dem_granules_view g = dem_world_granules(w);
+    double solid = 0, r = 0.5 * d->diameter;
+    for (size_t i = 0; i < g.count; ++i) solid += 4.0 / 3.0 * DEM_PI * g.radius[i] * g.radius[i] * g.radius[i];
+    out->solid_fraction = solid / (DEM_PI * r * r * out->bed_height);
+    return w;
+}
+
+// ------------------------------------------------------------------ output
+
+int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
+                             size_t len)
+{
+    char tmp[1100];
+    snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
+    fprintf(f, "t_s,cycle,loading,piston_y_m,displacement_m,strain,force_top_N,force_bottom_N,force_side_normal_N,"
+               "sigma_Pa,ke_over_elastic\n");
+    for (size_t k = 0; k < r->n_curve; ++k) {
+        const exp_compress_sample *s = &r->curve[k];
+        fprintf(f, "%.6g,%d,%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g\n", s->t, s->cycle, s->loading, s->piston_y,
+                s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic);
+    }
+    if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
+    if (!png_path) return 0;
+    // One series per cycle, displacement in mm against the piston force.
+    int nc = r->n_cycles > 0 ? r->n_cycles : 1;
+    size_t n = r->n_curve;
+    double *x = malloc((n + 1) * sizeof *x), *y = malloc((n + 1) * sizeof *y);
+    exp_plot_series *series = calloc((size_t)nc + 1, sizeof *series);
+    char (*labels)[32] = calloc((size_t)nc + 1, sizeof *labels);
+    if (!x || !y || !series || !labels) return free(x), free(y), free(series), free(labels), exp_fail(err, len, "out of memory");
+    size_t used = 0;
+    int ns = 0;
+    for (int c = 1; c <= nc; ++c) {
+        size_t first = used;
+        for (size_t k = 0; k < n; ++k)
+            if (r->curve[k].cycle == c && r->curve[k].displacement != 0)
+                x[used] = 1e3 * r->curve[k].displacement, y[used++] = r->curve[k].f_top;
+        if (used == first) continue;
+        snprintf(labels[ns], sizeof labels[ns], "cycle %d", c);
+        series[ns] = (exp_plot_series){used - first, x + first, y + first, labels[ns], {0, 0, 0}, 0};
+        exp_plot_colour(c - 1, series[ns].rgb);
+        ns++;
+    }
+    exp_plot_axes ax = {"Confined compression: force on the piston", "piston displacement (mm)", "force (N)", 0, 0, 0, 0, 0};
+    int rc = exp_plot_png(png_path, &ax, (size_t)ns, series, 900, 600, err, len);
+    free(x), free(y), free(series), free(labels);
+    return rc;
+}
+
+// ------------------------------------------------------------ config + CLI
+
+typedef struct compress_yaml {
+    char *experiment;
+    double diameter, depth, density, median_diameter, geometric_sd, truncation_sigmas, lambda;
+    double k_n, xi, mu_s, wall_mu_s;
+    char *damping;
+    double sigma_min, sigma_max, piston_speed, max_time;
+    int cycles, seed;
+} compress_yaml;
+
+#define F(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_DEFAULT, compress_yaml, member)
+static const cyaml_schema_field_t compress_fields[] = {
+    CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, compress_yaml, experiment, 1, 16),
+    F("diameter", diameter), F("depth", depth), F("density", density), F("median_diameter", median_diameter),
+    F("geometric_sd", geometric_sd), F("truncation_sigmas", truncation_sigmas), F("lambda", lambda), F("k_n", k_n),
+    F("xi", xi), F("mu_s", mu_s), F("wall_mu_s", wall_mu_s),
+    CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, compress_yaml, damping, 1, 32),
+    F("sigma_min", sigma_min), F("sigma_max", sigma_max), F("piston_speed", piston_speed), F("max_time", max_time),
+    CYAML_FIELD_INT("cycles", CYAML_FLAG_DEFAULT, compress_yaml, cycles),
+    CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, compress_yaml, seed), CYAML_FIELD_END};
+#undef F
+static const cyaml_schema_value_t compress_schema = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, compress_yaml, compress_fields)};
+static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
+
+int exp_is_compress_config(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char line[256];
+    int yes = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (line[0] == '#' || line[0] == '\n') continue;
+        yes = strncmp(line, "experiment: compression", 23) == 0;
+        break;
+    }
+    if (f) fclose(f);
+    return yes;
+}
+
+static int located(const char *path, const char *field, char *err, size_t len, const char *msg)
+{
+    int line = exp_yaml_line_of(path, field, 1);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
+}
+
+static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t len)
+{
+    *d = exp_default_compress_def();
+    d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
+    d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
+    if (mode < 0) return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
+    // Section 3.2: k_n = k_s = k_r; no rolling here (μ_r = 0 switches it off).
+    d->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, 0, (dem_damping_mode)mode};
+    d->wall = d->granule;
+    d->wall.mu_s = y->wall_mu_s;
+    d->sigma_min = y->sigma_min, d->sigma_max = y->sigma_max, d->piston_speed = y->piston_speed;
+    d->max_time = y->max_time, d->cycles = y->cycles, d->seed = (uint64_t)y->seed;
+    return 0;
+}
+
+static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
+{
+    const char *eq = strchr(set, '=');
+    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
+    char key[32], *end;
+    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
+    errno = 0;
+    double v = strtod(eq + 1, &end);
+    if (errno || end == eq + 1 || *end || !isfinite(v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    struct { const char *name; double *field; } numbers[] = {
+        {"k_n", &y->k_n}, {"mu_s", &y->mu_s}, {"wall_mu_s", &y->wall_mu_s}, {"xi", &y->xi}, {"lambda", &y->lambda},
+        {"sigma_min", &y->sigma_min}, {"sigma_max", &y->sigma_max}, {"piston_speed", &y->piston_speed},
+        {"max_time", &y->max_time}};
+    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
+        if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
+    if (strcmp(key, "seed") == 0 || strcmp(key, "cycles") == 0) {
+        if (v < 0 || v != floor(v) || v > 2147483647.0) return exp_fail(err, len, "--set %s: '%s' is not a non-negative integer", key, eq + 1);
+        *(strcmp(key, "seed") == 0 ? &y->seed : &y->cycles) = (int)v;
+        return 0;
+    }
+    if (strcmp(key, "mu_r") == 0) return exp_fail(err, len, "--set mu_r: the compression test has no rolling resistance");
+    return exp_fail(err, len, "--set %s: unknown key (known: k_n, mu_s, wall_mu_s, xi, lambda, seed, sigma_min, "
+                              "sigma_max, piston_speed, cycles, max_time)", key);
+}
+
+static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
+{
+    compress_yaml *y = NULL;
+    cyaml_err_t e = cyaml_load_file(path, &quiet, &compress_schema, (cyaml_data_t **)&y, NULL);
+    if (e != CYAML_OK) {
+        exp_fail(err, len, "%s: %s (check the keys and value types against configs/compression.yaml)", path,
+                 cyaml_strerror(e));
+        return NULL;
+    }
+    char msg[300];
+    int bad = 0;
+    for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
+    if (!bad && strcmp(y->experiment, "compression") != 0) bad = located(path, "experiment", err, len, "must be compression");
+    if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
+        // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
+        char field[48];
+        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
+        const char *leaf = strrchr(field, '.');
+        bad = located(path, leaf ? leaf + 1 : field, err, len, msg);
+    }
+    if (bad) {
+        cyaml_free(&quiet, &compress_schema, y, 0);
+        return NULL;
+    }
+    return y;
+}
+
+int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
+{
+    compress_yaml *y = load_config(path, n_sets, sets, d, err, len);
+    if (!y) return 1;
+    cyaml_free(&quiet, &compress_schema, y, 0);
+    return 0;
+}
+
+static double wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int make_dirs(const char *path, char *err, size_t len)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *p = buf + 1;; ++p) {
+        if (*p && *p != '/') continue;
+        char c = *p;
+        *p = '\0';
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return exp_fail(err, len, "cannot create '%s': %s", buf, strerror(errno));
+        if (!c) return 0;
+        *p = c;
+    }
+}
+
+typedef struct progress_state {
+    double last, start;
+} progress_state;
+
+static void show_progress(const char *phase, double t, size_t granules, void *ctx)
+{
+    progress_state *p = ctx;
+    double now = wall_seconds();
+    if (now - p->last < 10.0) return;
+    p->last = now;
+    fprintf(stderr, "compression: %s t = %.4f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
+}
+
+static void write_json(FILE *f, const compress_yaml *y, const exp_compress_def *d, const exp_compress_result *r,
+                       const dem_world *w, const char *status, double wall)
+{
+    char effects[1024];
+    dem_world_describe_features(w, effects, sizeof effects);
+    fprintf(f,
+            "{\"experiment\": \"compression\", \"status\": \"%s\", \"k_n\": %g, \"mu_s\": %g, \"wall_mu_s\": %g, "
+            "\"lambda\": %g, \"seed\": %d, \"sigma_min_Pa\": %g, \"sigma_max_Pa\": %g, \"piston_speed_m_s\": %g, "
+            "\"e_confined_Pa\": %.6g, \"e_confined_loading_Pa\": %.6g, \"stable\": %s, \"cycles\": [",
+            status, y->k_n, y->mu_s, y->wall_mu_s, y->lambda, y->seed, d->sigma_min, d->sigma_max, d->piston_speed,
+            r->e_confined, r->e_confined_loading, r->stable ? "true" : "false");
+    for (int k = 0; k < r->n_cycles; ++k) {
+        const exp_compress_cycle *c = &r->cycle[k];
+        fprintf(f,
+                "%s{\"e_loading_Pa\": %.6g, \"e_unloading_Pa\": %.6g, \"strain_start\": %.6g, \"strain_turn\": %.6g, "
+                "\"strain_end\": %.6g, \"permanent_strain\": %.6g, \"work_in_J\": %.6g, \"work_out_J\": %.6g}",
+                k ? ", " : "", c->e_loading, c->e_unloading, c->strain_start, c->strain_turn, c->strain_end,
+                c->permanent_strain, c->work_in, c->work_out);
+    }
+    fprintf(f,
+            "], \"bed_height_m\": %.6g, \"solid_fraction\": %.4f, \"coordination_at_sigma_max\": %.3f, "
+            "\"max_ke_over_elastic\": %.3g, \"granules\": %zu, \"fill_time_s\": %.4f, \"simulated_time_s\": %.4f, "
+            "\"wall_time_s\": %.2f, \"particle_steps\": %llu, \"dt_s\": %.6g, \"effects\": \"%s\"}\n",
+            r->bed_height, r->solid_fraction, r->coordination_turn, r->max_ke_over_elastic, r->granules, r->fill_time_s,
+            r->simulated_time_s, wall, r->particle_steps, dem_world_dt(w), effects);
+}
+
+static int write_outputs(const char *dir, const compress_yaml *y, const exp_compress_def *d,
+                         const exp_compress_result *r, const dem_world *w, double wall)
+{
+    char path[1100], png[1100], err[1200], tmp[1200];
+    snprintf(path, sizeof path, "%s/curve.csv", dir);
+    snprintf(png, sizeof png, "%s/force_displacement.png", dir);
+    int bad = exp_compress_write_curve(r, path, png, err, sizeof err);
+    if (!bad) {
+        snprintf(path, sizeof path, "%s/result.h5", dir);
+        dem_h5_writer *h5 = dem_h5_open(path, err, sizeof err);
+        dem_granules_view g = dem_world_granules(w);
+        dem_diagnostics dg = dem_world_diagnose(w);
+        bad = !h5 || dem_h5_write_frame(h5, dem_world_time(w), &g, &dg) ||
+              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
+        if (h5 && bad) snprintf(err, sizeof err, "%s", dem_h5_error(h5));
+        if (h5) bad |= dem_h5_close(h5, err, sizeof err);
+    }
+    if (!bad) {
+        snprintf(path, sizeof path, "%s/result.json", dir);
+        snprintf(tmp, sizeof tmp, "%s.tmp", path);
+        FILE *f = fopen(tmp, "w");
+        if (f) write_json(f, y, d, r, w, r->stable ? "ok" : "not stable", wall);
+        bad = !f || fclose(f) != 0 || rename(tmp, path) != 0;
+        if (bad) snprintf(err, sizeof err, "cannot write '%s'", path);
+    }
+    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
+    return bad;
+}
+
+int exp_compress_simulate(const char *path, int n_sets, char **sets, const char *out)
+{
+    char err[1024], dir[1024];
+    exp_compress_def d;
+    compress_yaml *y = load_config(path, n_sets, sets, &d, err, sizeof err);
+    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/compression");
+    if (make_dirs(dir, err, sizeof err)) {
+        fprintf(stderr, "granucal simulate: %s\n", err);
+        cyaml_free(&quiet, &compress_schema, y, 0);
+        return 1;
+    }
+    progress_state p = {0, wall_seconds()};
+    exp_compress_result r;
+    dem_world *w = exp_compress_run(&d, show_progress, &p, &r, err, sizeof err);
+    int rc = 1;
+    if (!w) {
+        fprintf(stderr, "granucal simulate: %s\n", err);
+        printf("{\"experiment\": \"compression\", \"status\": \"failed\", \"error\": \"%s\"}\n", err);
+    } else {
+        double wall = wall_seconds() - p.start;
+        fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));
+        int bad = write_outputs(dir, y, &d, &r, w, wall);
+        write_json(stdout, y, &d, &r, w, r.stable ? "ok" : "not stable", wall);
+        rc = bad;
+    }
+    exp_compress_result_free(&r);
+    dem_world_destroy(w);
+    cyaml_free(&quiet, &compress_schema, y, 0);
+    return rc;
+}
