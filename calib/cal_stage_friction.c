@@ -36,6 +36,7 @@ typedef struct search {
     int n_sim, angle_index;
     int failed;                  ///< the store failed: stop the search
     nlopt_opt opt;
+    double started;              ///< wall clock at the stage's start, for the ETA
     char *err;
     size_t len;
 } search;
@@ -67,6 +68,17 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
     k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
 }
 
+// "candidate i of at most N", with the time left at the pace so far.
+static void show_start(const search *s, double mu_s, double mu_r)
+{
+    int planned = s->t->grid * s->t->grid + s->t->max_evaluations, done = s->r->n;
+    double spent = cal_wall_seconds() - s->started;
+    char eta[48] = "";
+    if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
+    fprintf(stderr, "%s[%s] candidate %d of at most %d: mu_s = %.4g, mu_r = %.4g (%d speeds%s)%s", s->env->tty ? "\r\033[K" : "",
+            s->env->stage, done + 1, planned, mu_s, mu_r, s->n_sim, eta, s->env->tty ? "" : "\n");
+}
+
 static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
 {
     cal_friction_result *r = s->r;
@@ -79,8 +91,7 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
                                    : cal_drum_case_make(s->c, s->t, r->k_n, mu_s, mu_r, mu_s, mu_r);
     cal_record rec[CAL_MAX_RPM];
     double t0 = cal_wall_seconds();
-    if (s->env->tty) fprintf(stderr, "\r\033[K[%s] candidate %d: mu_s = %.4g, mu_r = %.4g ...", s->env->stage, r->n + 1, mu_s, mu_r);
-    else fprintf(stderr, "[%s] candidate %d: mu_s = %.4g, mu_r = %.4g\n", s->env->stage, r->n + 1, mu_s, mu_r);
+    show_start(s, mu_s, mu_r);
     if (cal_drum_evaluate(s->env, &dc, s->sim_rpm, s->n_sim, rec, s->err, s->len)) {
         s->failed = 1;
         return NULL;
@@ -202,7 +213,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     static char stage[64];
     snprintf(stage, sizeof stage, "%s", material ? material->name : "granule");
     env->stage = stage;
-    search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len};
+    search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
     if (set_targets(&s, angles, areas)) return 1;
     for (int i = 0; i < t->grid && !s.failed; ++i)
         for (int j = 0; j < t->grid && !s.failed; ++j) evaluate(&s, (i + 0.5) / t->grid, (j + 0.5) / t->grid, 1);
