@@ -10,7 +10,7 @@
 //       sphere/granular: id type diameter density x y z), the peers' contact
 //       coefficients (OUTDIR/drum_N.liggghts.coeffs, OUTDIR/drum_N.lammps.coeffs)
 //       and OUTDIR/drum_N.vars (shell: λ, depth, dt_crit, granucal's steps).
-//   bench_drum_peers run DATA STEPS THREADS VARIANT DT [RPM [allow]]
+//   bench_drum_peers run DATA STEPS THREADS VARIANT DT [RPM [allow]]   (DT 0: the engine's network step)
 //       Reads DATA, builds the drum at the real parameters (VARIANT: all,
 //       norolling, notangential), turns it at RPM (40) and times STEPS steps
 //       of DT s on THREADS OpenMP threads; prints one CSV line (see HEADER)
@@ -475,7 +475,9 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
     else if (strcmp(variant, "notangential") == 0) p.mu_s = 0;
     else if (strcmp(variant, "all") != 0) return fprintf(stderr, "variant: all, norolling or notangential\n"), 1;
     dem_world_set_granule_contact(w, &p);
-    dem_status st = dem_world_prepare(w);
+    // DT 0: the step the engine picks for this settled bed (its network step,
+    // as exp_drum_rotate turns a drum).
+    dem_status st = dt > 0 ? dem_world_prepare(w) : dem_world_adopt_network_dt(w);
     if (st != DEM_OK) return fprintf(stderr, "%s\n", dem_world_error(w)), 1;
     fprintf(stderr, "%s\n", dem_world_dt_report(w));
     size_t n = dem_world_granules(w).count;

@@ -55,7 +55,7 @@ if [ ${#need[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
   $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}" >&2
 fi
-MPIRUN=(mpirun --oversubscribe --bind-to none)
+MPIRUN=(mpirun --oversubscribe --bind-to none --mca mpi_yield_when_idle 1)
 [ "$(id -u)" -eq 0 ] && MPIRUN+=(--allow-run-as-root)
 
 # ---- granucal's bench. By default from a clean export of HEAD (others edit
@@ -97,7 +97,7 @@ echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,c
 run_granucal() {
   local n=$1 th=$2 rep=$3 var=$4 steps=$5 dt=$6 rpm=${7:-40} allow=${8:-}
   local line
-  line=$(OMP_NUM_THREADS=$th OMP_PROC_BIND=false "$BENCH" run "$BEDS/drum_$n.data" "$steps" "$th" "$var" "$dt" "$rpm" $allow 2>>"$LOG") || true
+  line=$(OMP_NUM_THREADS=$th OMP_PROC_BIND=false OMP_WAIT_POLICY=${GRANUCAL_WAIT:-passive} "$BENCH" run "$BEDS/drum_$n.data" "$steps" "$th" "$var" "$dt" "$rpm" $allow 2>>"$LOG") || true
   if [ -z "$line" ]; then
     echo "granucal,$n,$th,$rep,$var,$steps,$dt,,,,failed,,,,,," >> "$RAW"; return
   fi
@@ -152,7 +152,7 @@ for f in $FACTORS; do
   run_peer lammps $N0 1 "scan$f" $SCAN_STEPS "$dt" 0 $SCAN_STEPS
 done
 # granucal at the step its engine picks for a settled bed (network step)
-run_granucal $N0 1 scannet all $SCAN_STEPS "$DT_NET" 0
+run_granucal $N0 1 scannet all $SCAN_STEPS 0 0
 
 # ---- 2. timing at one common step: granucal's a-priori step, or less if a
 # peer needs less (from the scan) so all three integrate the same stable run.
@@ -187,6 +187,17 @@ for n in $SIZES; do
       fi
     done
   done
+done
+
+# The same granucal run with libgomp's default waiting (threads spin at each
+# of the step's fork-join barriers): on a machine shared beyond its cores this
+# is what a user gets without OMP_WAIT_POLICY=passive.
+echo "N=$N0 threads=2: granucal with the default OpenMP wait policy" >&2
+for rep in $(seq 1 "$REPS"); do
+  GRANUCAL_WAIT="" run_granucal $N0 2 "$rep" all "$(steps_for $N0)" "$DT"
+  sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,all_default_wait,/' "$RAW"
+  run_granucal $N0 2 "$rep" all "$(steps_for $N0)" "$DT"
+  sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,all_passive_wait,/' "$RAW"
 done
 
 # ---- 3. table, 1 s of drum, accuracy guard, final line
@@ -237,7 +248,7 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit()}):
                 "%.2f" % ratios['lammps'] if 'lammps' in ratios else ""))
             if code == 'granucal': summary[('ratio', n, th)] = ratios
     for th in ('1', '2'):
-        for v in ('norolling', 'notangential'):
+        for v in ('norolling', 'notangential', 'all_default_wait', 'all_passive_wait'):
             rs = [r for r in sel(N=str(n), threads=th, code='granucal', variant=v) if r['status'] == 'ok']
             if rs:
                 al = {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, code='granucal', variant='all')}
@@ -275,9 +286,9 @@ def per_core_ratio(peer):
     out = []
     for g in pc('granucal'):
         for p in pc(peer):
-            if p['rep'] == g['rep'] and p['threads'] == g['threads']:
+            if p['rep'] == g['rep'] and p['threads'] == g['threads'] == '1':
                 out.append((num(g['psps']) / int(g['threads'])) / (num(p['psps']) / int(p['threads'])))
     return med(out)
-print("\n(per core: particle-steps/s divided by threads or ranks; median over repetitions and 1 and 2 threads, N = 20000)")
+print("\n(per core: 1 thread vs 1 rank, particle-steps/s, N = 20000, median of the per-repetition ratios)")
 print("granucal_per_core_vs_liggghts=%.2f granucal_per_core_vs_lammps=%.2f" % (per_core_ratio('liggghts'), per_core_ratio('lammps')))
 EOF
