@@ -3,7 +3,7 @@
 # lining, simulated by granucal itself at the paper's Table 3 parameters. The paper publishes
 # its CSA measurements only as figures (Fig. 15, 18), so no lab numbers exist to ship; this
 # stands in for them so the calibration has a curve to fit, at a fidelity higher than the
-# CI tier (drum lambda = 4096 here vs 32768 there). Replace it with your own lab CSV (same
+# CI tier (drum lambda = 16384 here, twice the granules of the ci tier's 32768). Replace it with your own lab CSV (same
 # schema) to calibrate a real powder.
 #   usage: experiments/data/make_synthetic_csa.sh [BUILD_DIR]   (needs python3 for the JSON)
 set -euo pipefail
@@ -16,7 +16,8 @@ mkdir -p "$out"
 # on a shared, oversubscribed machine slow a run down by orders of magnitude.
 export OMP_NUM_THREADS=1
 run() { # lining surface-name
-  "$build/granucal" simulate configs/drum.yaml --set wall="$1" --set max_time=4 --rpm-list "$rpms" \
+  "$build/granucal" simulate configs/drum.yaml --set wall="$1" --set lambda=16384 --set slice_depth=0.025 \
+    --set max_time=3 --rpm-list "$rpms" \
     --out "$out/$1" > "$out/$1.json" 2> "$out/$1.log"
 }
 run granules & run aluminium & wait
@@ -27,8 +28,8 @@ out, commit = sys.argv[1], sys.argv[2]
 names = {"granules": "spray-dried powder", "aluminium": "Aluminium", "PP": "PP", "PTFE": "PTFE"}
 with open("experiments/data/occupied_area.csv", "w") as f:
     f.write("# SYNTHETIC - not lab data. Occupied cross-section area (eq. 20) simulated by granucal\n")
-    f.write(f"# (commit {commit}) at Table 3's parameters: configs/drum.yaml, lambda 4096, 15 mm periodic\n")
-    f.write("# slice, max_time 4 s, steady-state window 1 s; csa_sd_percent is the spread over the last\n")
+    f.write(f"# (commit {commit}) at Table 3's parameters: configs/drum.yaml, lambda 16384, 25 mm periodic\n")
+    f.write("# slice, max_time 3 s, steady-state window 1 s; csa_sd_percent is the spread over the last\n")
     f.write("# window. Made by: experiments/data/make_synthetic_csa.sh\n")
     f.write("surface,rpm,csa_percent,csa_sd_percent\n")
     for lining, surface in names.items():
