@@ -111,12 +111,14 @@ static void on_row(int terminator, void *ctx)
     (void)terminator;
     reader *r = ctx;
     if (r->failed) return;
-    if (r->n_fields != N_COLUMNS) {
+    if (!r->header_seen) {
+        if (r->n_fields != N_COLUMNS) r->fields[0][0] = '\0'; // not the header, whatever its fields
+        check_header(r);
+    } else if (r->n_fields != N_COLUMNS) {
         char n[32];
         snprintf(n, sizeof n, "%d", r->n_fields);
         fail_at(r, "row", "has %s fields, expected 4", n);
     } else if (r->too_long) fail_at(r, "row", "%s", "a field is longer than 63 characters");
-    else if (!r->header_seen) check_header(r);
     else add_point(r);
     r->n_fields = 0, r->too_long = 0;
 }

@@ -2,6 +2,7 @@
 // YAML loading with located errors (see exp_yaml.h).
 #include "exp_yaml.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -51,6 +52,9 @@ static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_l
 int exp_yaml_load(const char *path, const cyaml_schema_value_t *schema, void **out, const char *hint, char *err,
                   size_t len)
 {
+    FILE *f = fopen(path, "r");
+    if (!f) return exp_fail(err, len, "%s: cannot open: %s", path, strerror(errno));
+    fclose(f);
     log_capture c = {{0}, {0}, 0};
     cyaml_config_t cfg = {.log_fn = capture, .log_ctx = &c, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
     *out = NULL;

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# granucal calibrate refuses bad input before the first simulation: each case must exit
+# non-zero within seconds, print one error naming the file, line and field, and leave no
+# results behind.
+#   usage: bad_inputs.sh GRANUCAL SOURCE_DIR WORK_DIR
+set -uo pipefail
+bin=$1 src=$2 work=$3
+rm -rf "$work" && mkdir -p "$work/data" "$work/configs"
+cp "$src/experiments/data/repose_angle.csv" "$work/data/"
+printf 'surface,rpm,csa_percent,csa_sd_percent\n' > "$work/data/occupied_area.csv"
+for s in "spray-dried powder" Aluminium PP PTFE; do
+  for r in 4 40 80 105 116; do echo "$s,$r,45,0.5" >> "$work/data/occupied_area.csv"; done
+done
+sed 's|\.\./experiments/data/|../data/|' "$src/configs/calibration.yaml" > "$work/configs/good.yaml"
+fails=0
+# expect NAME EXPECTED-TEXT -- ARGS...: non-zero exit, the text in stderr, under 20 s.
+expect() {
+  local name=$1 want=$2; shift 3
+  local start=$SECONDS out
+  out=$(timeout 20 "$bin" calibrate "$@" 2>&1 >/dev/null); local code=$?
+  if [ $code -eq 0 ] || [ $code -eq 124 ] || ! grep -qF -- "$want" <<< "$out"; then
+    echo "FAIL $name: exit $code, wanted '$want' in: $out"; fails=$((fails + 1))
+  else
+    echo "ok   $name ($((SECONDS - start)) s): $(head -1 <<< "$out")"
+  fi
+}
+edit() { # edit NAME SED-EXPRESSION: a copy of the good config with one change
+  sed "$2" "$work/configs/good.yaml" > "$work/configs/$1.yaml"; echo "$work/configs/$1.yaml"
+}
+csv() { # csv NAME CONTENT: a config whose angle file is CONTENT
+  printf '%b' "$2" > "$work/data/$1.csv"
+  sed "s|repose_angle: ../data/repose_angle.csv|repose_angle: ../data/$1.csv|" "$work/configs/good.yaml" > "$work/configs/$1.yaml"
+  echo "$work/configs/$1.yaml"
+}
+out=(--out "$work/out")
+expect "missing config" "nonexistent.yaml" -- "$work/configs/nonexistent.yaml" "${out[@]}"
+expect "negative friction" "pour_mu_s.yaml:" -- "$(edit pour_mu_s 's/^pour_mu_s: 0.5/pour_mu_s: -0.5/')" "${out[@]}"
+expect "fill above 100 %" "fill: 1.5 must be in (0, 1)" -- "$(edit fill 's/^fill: 0.43/fill: 1.5/')" "${out[@]}"
+expect "text in a number" ": xi: Invalid FLOAT value" -- "$(edit xi 's/^xi: 0.7/xi: high/')" "${out[@]}"
+expect "unknown key" "viscosity: Unexpected key" -- "$(edit key 's/^seed: 1/seed: 1\nviscosity: 2/')" "${out[@]}"
+expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
+expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
+expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
+expect "empty CSV" "empty.csv:1: header" -- "$(csv empty '')" "${out[@]}"
+expect "wrong columns" "cols.csv:1: header" -- "$(csv cols 'surface,rpm,angle\nPTFE,4,31\n')" "${out[@]}"
+expect "NaN in CSV" "nan.csv:2: angle_deg" -- "$(csv nan 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,nan,0.5\n')" "${out[@]}"
+expect "negative rpm" "rpm.csv:2: rpm" -- "$(csv rpm 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,-4,31.9,0.5\n')" "${out[@]}"
+expect "truncated CSV" "trunc.csv:2: row" -- "$(csv trunc 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31')" "${out[@]}"
+expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
+expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
+[ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }
+echo "$fails failure(s)"
+exit $((fails > 0))
