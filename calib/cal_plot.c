@@ -62,6 +62,7 @@ static void axes(cairo_t *cr, const frame *f, const char *title, const char *xl,
         int ticks = log ? (int)lround(log10(hi / lo)) : 5;
         for (int k = 0; k <= ticks; ++k) {
             double v = log ? lo * pow(10, k) : lo + (hi - lo) * k / ticks;
+            if (v > hi * (1 + 1e-9)) break; // a log axis may end between decades
             snprintf(s, sizeof s, "%.3g", v);
             if (axis) {
                 cairo_move_to(cr, LEFT - 5, ty(f, v)), cairo_line_to(cr, LEFT, ty(f, v));
@@ -76,7 +77,7 @@ static void axes(cairo_t *cr, const frame *f, const char *title, const char *xl,
     text_at(cr, (LEFT + W - RIGHT) / 2.0, 30, title, 0.5, 16);
     text_at(cr, (LEFT + W - RIGHT) / 2.0, H - 25, xl, 0.5, 14);
     cairo_save(cr);
-    cairo_move_to(cr, 25, (TOP + H - BOTTOM) / 2.0);
+    cairo_translate(cr, 25, (TOP + H - BOTTOM) / 2.0);
     cairo_rotate(cr, -DEM_PI / 2);
     text_at(cr, 0, 0, yl, 0.5, 14);
     cairo_restore(cr);
