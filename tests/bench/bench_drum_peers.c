@@ -12,7 +12,8 @@
 //       and OUTDIR/drum_N.vars (shell: λ, depth, dt_crit, granucal's steps).
 //   bench_drum_peers run DATA STEPS THREADS VARIANT DT [RPM [allow]]   (DT 0: the engine's network step)
 //       Reads DATA, builds the drum at the real parameters (VARIANT: all,
-//       norolling, notangential), turns it at RPM (40) and times STEPS steps
+//       norolling, notangential; morton: all, granules added in Morton
+//       order), turns it at RPM (40) and times STEPS steps
 //       of DT s on THREADS OpenMP threads; prints one CSV line (see HEADER)
 //       with the angle and CSA before and after (the accuracy guard) and a
 //       checksum of the final positions (bitwise equal for 1 and 2 threads).
@@ -207,8 +208,36 @@ static int write_data(const char *path, const dem_world *w, const scene *s, cons
 }
 
 // Reads a data file written above into a new world; returns NULL on error.
+typedef struct atom_rec {
+    uint64_t key;
+    double d, rho, x, y, z;
+} atom_rec;
+
+static int cmp_key(const void *a, const void *b)
+{
+    uint64_t x = ((const atom_rec *)a)->key, y = ((const atom_rec *)b)->key;
+    return (x > y) - (x < y);
+}
+
+// Spreads the low 21 bits of v to every third bit (Morton interleave).
+static uint64_t spread3(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+}
+
+// Reads a data file written above into a new world; returns NULL on error.
+// morton: add the granules in Morton (Z-curve) order of their positions
+// instead of the file's order (the file holds them in placement order,
+// random in space) -- the reordering lever, measured without touching the
+// engine (LIGGGHTS and LAMMPS sort their atoms spatially themselves).
 static dem_world *read_data(const char *path, scene *s, double dt, int threads, const dem_contact_params *gg,
-                            int allow)
+                            int allow, int morton)
 {
     FILE *f = fopen(path, "r");
     if (!f) return fprintf(stderr, "cannot open %s\n", path), NULL;
@@ -217,22 +246,40 @@ static dem_world *read_data(const char *path, scene *s, double dt, int threads, 
     if (!fgets(line, sizeof line, f) || sscanf(line, "granucal bench_drum_peers lambda=%lf depth=%lf", &lambda, &depth) != 2)
         return fclose(f), fprintf(stderr, "%s: not a bench_drum_peers data file\n", path), NULL;
     *s = make_scene(lambda, depth);
-    dem_contact_params p = gg ? *gg : s->gg;
-    dem_world *w = create_world(s, &p, &s->gw, dt, threads, 0, allow);
+    size_t n = 0, cap = 1024;
+    atom_rec *a = malloc(cap * sizeof *a);
     int in_atoms = 0;
-    while (fgets(line, sizeof line, f)) {
+    while (a && fgets(line, sizeof line, f)) {
         if (!in_atoms) {
             in_atoms = strncmp(line, "Atoms", 5) == 0;
             continue;
         }
         long id;
         int t;
-        double d, rho, x, y, z;
-        if (sscanf(line, "%ld %d %lf %lf %lf %lf %lf", &id, &t, &d, &rho, &x, &y, &z) != 7) continue;
-        if (dem_world_add_granule(w, dem_v3(x, y, z), dem_v3(0, 0, 0), dem_v3(0, 0, 0), 0.5 * d, rho) < 0)
-            return fclose(f), fprintf(stderr, "%s\n", dem_world_error(w)), dem_world_destroy(w), NULL;
+        atom_rec r = {0};
+        if (sscanf(line, "%ld %d %lf %lf %lf %lf %lf", &id, &t, &r.d, &r.rho, &r.x, &r.y, &r.z) != 7) continue;
+        if (n == cap) {
+            atom_rec *b = realloc(a, 2 * cap * sizeof *a);
+            if (!b) free(a);
+            a = b, cap *= 2;
+            if (!a) break;
+        }
+        const double span = 2.4 * DRUM_R, q = (double)(1u << 21) - 1;
+        r.key = spread3((uint64_t)((r.x + 1.2 * DRUM_R) / span * q)) |
+                spread3((uint64_t)((r.y + 1.2 * DRUM_R) / span * q)) << 1 |
+                spread3((uint64_t)(r.z / depth * q)) << 2;
+        a[n++] = r;
     }
     fclose(f);
+    if (!a) return fprintf(stderr, "out of memory\n"), NULL;
+    if (morton) qsort(a, n, sizeof *a, cmp_key);
+    dem_contact_params p = gg ? *gg : s->gg;
+    dem_world *w = create_world(s, &p, &s->gw, dt, threads, 0, allow);
+    for (size_t i = 0; i < n; ++i)
+        if (dem_world_add_granule(w, dem_v3(a[i].x, a[i].y, a[i].z), dem_v3(0, 0, 0), dem_v3(0, 0, 0), 0.5 * a[i].d,
+                                  a[i].rho) < 0)
+            return free(a), fprintf(stderr, "%s\n", dem_world_error(w)), dem_world_destroy(w), NULL;
+    free(a);
     return w;
 }
 
@@ -335,7 +382,7 @@ static int emit(dem_world *w, const scene *sp, const char *outdir, double t0)
 
     // Granucal's own steps on the data as read back (explicit dashpot, the default).
     scene s2;
-    dem_world *r = read_data(path, &s2, 0, 2, NULL, 0);
+    dem_world *r = read_data(path, &s2, 0, 2, NULL, 0, 0);
     if (!r || dem_world_prepare(r) != DEM_OK) return fprintf(stderr, "read back failed\n"), 1;
     double dt_apriori = dem_world_dt(r), dt_crit = sqrt(dem_world_min_mass(r) / s.gg.k_n);
     char rep_apriori[1024], rep_net[1024];
@@ -468,12 +515,14 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
     if (!probe) return fprintf(stderr, "cannot open %s\n", data), 1;
     fclose(probe);
     // First read with the scene's own contact, then apply the variant.
-    dem_world *w = read_data(data, &s, dt, threads, NULL, allow);
+    const int morton = strcmp(variant, "morton") == 0;
+    dem_world *w = read_data(data, &s, dt, threads, NULL, allow, morton);
     if (!w) return 1;
     p = s.gg;
     if (strcmp(variant, "norolling") == 0) p.mu_r = 0;
     else if (strcmp(variant, "notangential") == 0) p.mu_s = 0;
-    else if (strcmp(variant, "all") != 0) return fprintf(stderr, "variant: all, norolling or notangential\n"), 1;
+    else if (strcmp(variant, "all") != 0 && !morton)
+        return fprintf(stderr, "variant: all, norolling, notangential or morton\n"), 1;
     dem_world_set_granule_contact(w, &p);
     // DT 0: the step the engine picks for this settled bed (its network step,
     // as exp_drum_rotate turns a drum).
@@ -509,7 +558,7 @@ int main(int argc, char **argv)
                        argc > 8 && strcmp(argv[8], "allow") == 0);
     if (argc >= 2 && strcmp(argv[1], "header") == 0) return puts(HEADER), 0;
     fprintf(stderr,
-            "usage: %s build N OUTDIR [TILES...] | run DATA STEPS THREADS all|norolling|notangential DT [RPM [allow]] | header\n",
+            "usage: %s build N OUTDIR [TILES...] | run DATA STEPS THREADS all|norolling|notangential|morton DT [RPM [allow]] | header\n",
             argv[0]);
     return 2;
 }

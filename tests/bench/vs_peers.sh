@@ -13,6 +13,9 @@
 #   --out DIR where raw.csv and the log go (default build-bench/vs_peers)
 #   --rebuild rebuild the settled beds even if they exist
 #   --worktree build granucal from the work tree as it is (default: HEAD)
+#   --levers  only the reordering lever: granucal with the granules in the data
+#             file's order (placement order, random in space) against the same
+#             granules added in Morton order, 1 thread, all N (levers.csv)
 #
 # Order: for each N and thread count, granucal, LIGGGHTS, LAMMPS, repeated R
 # times (A B C A B C ...), so the shared machine's noise hits all three alike;
@@ -24,7 +27,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=${BUILD:-$ROOT/build-bench}
 ARGS="$*"
-QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0
+QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0 LEVERS=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) QUICK=1; REPS=2 ;;
@@ -33,6 +36,7 @@ while [ $# -gt 0 ]; do
     --out) OUT=$2; shift ;;
     --rebuild) REBUILD=1 ;;
     --worktree) WORKTREE=1 ;;
+    --levers) LEVERS=1 ;;
     -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
@@ -88,8 +92,8 @@ steps_for() { # ~5e6 particle-steps per run (x --scale)
 }
 vars() { (set +u; . "$BEDS/drum_$1.vars"; eval echo "\$$2"); }
 
-RAW=$OUT/raw.csv
-LOG=$OUT/runs.log
+RAW=$OUT/raw.csv LOG=$OUT/runs.log
+[ $LEVERS -eq 1 ] && RAW=$OUT/levers.csv LOG=$OUT/levers.log
 echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
 : > "$LOG"
 
@@ -137,6 +141,28 @@ DT_NET=$(vars $N0 DT_NETWORK)
 echo "machine: $(lscpu | awk -F: '/Model name/ {gsub(/^ +/, "", $2); print $2}'), $(nproc) cores; load $(cut -d' ' -f1-3 /proc/loadavg)" | tee "$OUT/machine.txt"
 echo "commit: $(git -C "$ROOT" rev-parse --short HEAD); granucal built from: $GRANUCAL_SRC" | tee -a "$OUT/machine.txt"
 echo "command: tests/bench/vs_peers.sh $ARGS" | tee -a "$OUT/machine.txt"
+
+if [ $LEVERS -eq 1 ]; then
+  for n in $SIZES; do
+    for rep in $(seq 1 "$REPS"); do
+      echo "levers: N=$n rep $rep/$REPS" >&2
+      run_granucal "$n" 1 "$rep" all "$(steps_for "$n")" "$DT_G"
+      run_granucal "$n" 1 "$rep" morton "$(steps_for "$n")" "$DT_G"
+    done
+  done
+  python3 - "$RAW" <<'EOF'
+import csv, statistics as st, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r['status'] == 'ok']
+print("granucal, 1 thread: particle-steps/s with the granules in file order and in Morton order (medians)")
+print("%7s %16s %16s %8s" % ("N", "file order", "Morton order", "speedup"))
+for n in sorted({int(r['N']) for r in rows}):
+    a = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'all'}
+    m = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'morton'}
+    print("%7d %16.3e %16.3e %8.2f" % (n, st.median(a.values()), st.median(m.values()),
+                                       st.median([m[k] / a[k] for k in a if k in m])))
+EOF
+  exit 0
+fi
 
 # ---- 1. largest step each code keeps a dense bed at rest (N = 5 000, drum still)
 # A step is kept if the run completes, nothing is lost and the kinetic energy
