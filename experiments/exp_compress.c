@@ -23,13 +23,15 @@
 #include "exp_pour.h"
 #include "exp_scene.h"
 
-#define FILL_GRAVITY 1000.0 // pour and settle under 1000 g (see exp_compress_run)
+#define FILL_GRAVITY 30.0 // pour and settle under 30 g (see exp_compress_run)
 // exp_ke_ratio divides by (bed mass)·9.81·d50: the thresholds carry the
 // factor FILL_GRAVITY, and a fall under it takes 1/sqrt(FILL_GRAVITY) as long.
 #define LAYER_KE_RATIO (1e-2 * FILL_GRAVITY)
-#define LAYER_MAX_TIME 0.02
+#define LAYER_MAX_TIME 0.1
 #define SETTLE_KE_RATIO (1e-6 * FILL_GRAVITY)
-#define SETTLE_MAX_TIME 0.03
+#define SETTLE_MAX_TIME 0.1
+#define RELAX_MAX_TIME 0.02
+#define APPROACH_FACTOR 10.0
 #define WALL_SIDE 0
 #define WALL_FLOOR 1
 #define WALL_PISTON 2
@@ -125,8 +127,10 @@ static void move_piston(dem_world *w, double y) { w->walls[WALL_PISTON].def.poin
 static int run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
                           const char *phase)
 {
-    for (double t = 0; t < max_time; t += 0.002) {
-        if (exp_run_for(w, 0.002, progress, ctx, phase)) return 1;
+    uint64_t chunk = (uint64_t)(0.002 / dem_world_dt(w)) + 1; // exp_run_for steps 0.01 s at a time
+    for (double t0 = dem_world_time(w); dem_world_time(w) - t0 < max_time;) {
+        if (dem_world_step(w, chunk) != DEM_OK) return 1;
+        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
         if (exp_ke_ratio(w, d50) < ratio) break;
     }
     return 0;
@@ -234,17 +238,22 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
     double area = DEM_PI * 0.25 * d->diameter * d->diameter, dt = dem_world_dt(w);
     double step_travel = d->piston_speed * dt;
     uint64_t per_sample = (uint64_t)(SAMPLE_STRAIN * d->depth / step_travel) + 1;
-    double y = bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda);
+    double y = fmin(w->walls[WALL_PISTON].def.point.y, bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda));
     move_piston(w, y);
     curve_buf c = {0};
-    int loading = 1, cycle = 1, touched = 0;
+    int loading = 1, cycle = 1, touched = 0, approaching = 1;
     double h0 = NAN, t0 = dem_world_time(w);
     size_t turn_at = 0, start_at = 0;
     unsigned long long steps = 0;
     exp_compress_cycle *cy = &out->cycle[0];
     while (1) {
+        // Approach: the struck-off surface is as rough as the largest granule,
+        // and the piston meets it across the die only millimetres down; it
+        // travels at APPROACH_FACTOR × the test speed until σ reaches a
+        // quarter of σ_min (the Instron's approach), then at the test speed.
+        double travel = approaching ? APPROACH_FACTOR * step_travel : step_travel;
         for (uint64_t s = 0; s < per_sample; ++s) {
-            y += loading ? -step_travel : step_travel;
+            y += loading ? -travel : travel;
             move_piston(w, y);
             if (dem_world_step(w, 1) != DEM_OK) return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
         }
@@ -257,6 +266,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         dem_diagnostics dg = dem_world_diagnose(w);
         sm.ke_over_elastic = dg.potential_elastic > 0 ? (dg.ke_translational + dg.ke_rotational) / dg.potential_elastic : 0;
         sm.cycle = cycle, sm.loading = loading;
+        if (sm.sigma >= 0.25 * d->sigma_min) approaching = 0;
         if (isnan(h0) && sm.sigma >= d->sigma_min) {
             h0 = y; // the bed's height at σ_min: the strain reference (eq. 19)
             start_at = c.n;
@@ -333,6 +343,17 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
         }
     dem_world_destroy(f);
     if (!w) return NULL;
+    // The bed carries the overlaps of FILL_GRAVITY·g; released under g they
+    // would launch granules (the default dashpot acts only on approach), so
+    // the piston is lowered onto the bed first and the bed relaxes under it.
+    move_piston(w, bed_top(w) + 0.02 * dem_gsd_max_diameter(&gsd));
+    if (dem_world_prepare(w) != DEM_OK ||
+        run_until_rest(w, gsd.median_diameter, 1e-6, RELAX_MAX_TIME, progress, ctx, "relax")) {
+        exp_fail(err, len, "%s", dem_world_error(w));
+        dem_world_destroy(w);
+        return NULL;
+    }
+    out->fill_time_s = dem_world_time(w) + out->fill_time_s;
     out->granules = dem_world_granules(w).count;
     if (cycle_piston(w, d, progress, ctx, out, err, len)) {
         dem_world_destroy(w);
