@@ -285,6 +285,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
             out->coordination_turn = dg.coordination;
             turn_at = c.n - 1;
             loading = 0;
+            if (d->stop_at_last_turn && cycle == d->cycles) break;
         } else if (!loading && sm.sigma <= d->sigma_min) {
             cy->sigma_end = sm.sigma, cy->strain_end = sm.strain;
             cy->work_out = -piston_work(c.s, turn_at, c.n - 1);

@@ -40,6 +40,7 @@ typedef struct exp_compress_def {
     int cycles;          ///< loading–unloading cycles (≥ 2: E' from the last, stability from the last two)
     double max_time;     ///< s of piston motion at most
     uint64_t seed;
+    int stop_at_last_turn; ///< stop at the last cycle's σ_max (the bed under load; for tests), 0: complete it
 } exp_compress_def;
 
 exp_compress_def exp_default_compress_def(void);
