@@ -242,7 +242,9 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     memset(out, 0, sizeof *out);
     dem_status st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
     if (st != DEM_OK) return st;
-    dem_world_set_wall_spin(w, 0, o->rpm * 2.0 * DEM_PI / 60.0);
+    // The end plates are part of the drum and turn with it (walls 1 and 2
+    // of a full drum; they stood still before, dragging the bed's faces).
+    for (int k = 0; k < (d->periodic ? 1 : 3); ++k) dem_world_set_wall_spin(w, k, o->rpm * 2.0 * DEM_PI / 60.0);
     int per_window = (int)(o->window / o->sample_interval + 0.5), cap = (int)(o->max_time / o->sample_interval) + 2;
     exp_drum_measure *m = malloc((size_t)cap * sizeof *m);
     if (!m) return DEM_ERR_NOMEM;
