@@ -216,6 +216,12 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
         if (cal_stage_stiffness(&r->env, r->c, r->t, &r->stiffness, r->err, sizeof r->err)) return 1;
         if (!isfinite(r->stiffness.chosen_k))
             return exp_fail(r->err, sizeof r->err, "stage 1: no candidate's CN is within the tolerance of the stiff limit");
+        if (!r->stiffness.resolved) {
+            fprintf(stderr, "stage 1: the CN of the softest candidate is within the noise of the stiff limit: the sweep "
+                            "does not resolve the stiffness at this tier; using the config's k_n = %g N/m\n", r->c->k_n);
+            *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
+            return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, r->err, sizeof r->err);
+        }
         *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)";
         return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, r->err, sizeof r->err);
     }

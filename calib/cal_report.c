@@ -374,9 +374,15 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
         for (int i = 0; i < s->n; ++i)
             fprintf(f, "| %g | %.3f | %.3f | %.3f | %.3f | %d | %d |\n", s->k[i], s->cn_mean[i], s->cn_sd[i], s->wall_cn[i],
                     s->solid_fraction[i], s->granules[i], s->failed[i]);
-        fprintf(f, "\nStiff limit %.3f (the stiffest candidate); tolerance %.3f (%s). Chosen: **k_n = %g N/m**, the "
-                   "smallest k from which every stiffer candidate stays within the tolerance.\n",
-                s->stiff_limit, s->tolerance, s->tolerance_rule, s->chosen_k);
+        fprintf(f, "\nStiff limit %.3f (the stiffest candidate); tolerance %.3f (%s). ", s->stiff_limit, s->tolerance,
+                s->tolerance_rule);
+        if (s->resolved)
+            fprintf(f, "Chosen: **k_n = %g N/m**, the smallest k from which every stiffer candidate stays within the "
+                       "tolerance.\n", s->chosen_k);
+        else
+            fprintf(f, "**Unresolved:** even the softest candidate (%g N/m) is within the tolerance, so this tier's sweep "
+                       "shows no change to stop at; the config's k_n = %g N/m was used. A finer cylinder (smaller "
+                       "cylinder_lambda: more layers, more pressure) resolves it.\n", s->k[0], o->config->k_n);
     }
     if (o->granule) report_friction(f, o->granule);
     for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w]);

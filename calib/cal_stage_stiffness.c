@@ -52,6 +52,10 @@ static void choose(cal_stiffness_result *s)
         if (!isfinite(s->cn_mean[i]) || fabs(s->cn_mean[i] - s->stiff_limit) > s->tolerance) break;
         s->chosen_k = s->k[i];
     }
+    // If the softest candidate is already within the noise of the stiff
+    // limit, the sweep never saw the CN change: at this fidelity (few
+    // layers, little pressure) it cannot say where the change stops.
+    s->resolved = isfinite(s->chosen_k) && s->chosen_k > s->k[0];
 }
 
 int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, cal_stiffness_result *out, char *err,

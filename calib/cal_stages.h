@@ -23,6 +23,7 @@ typedef struct cal_stiffness_result {
     double tolerance;            ///< |CN - stiff limit| allowed
     const char *tolerance_rule;  ///< how the tolerance was set
     double chosen_k;
+    int resolved;                ///< 0 if even the softest candidate is within the tolerance: the sweep shows no change
     double wall_time_s;
 } cal_stiffness_result;
 
