@@ -10,17 +10,19 @@ cd "$src"
 args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 2)
 "$bin" "${args[@]}" --out "$work/whole" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
 total=$(($(wc -l < "$work/whole/simulations.csv") - 1))
-# Kill points spread over the run: seconds after start, then the same command resumes.
-for delay in 3 11 23 37 52; do
-  "$bin" "${args[@]}" --out "$work/killed" > "$work/killed.$delay.log" 2>&1 &
+records() { ls "$work/killed/store" 2>/dev/null | grep -c '\.yaml$' || true; }
+# Five kill points spread over the run: once N records are stored (0 = during the first
+# fill), 2 s later, in whatever phase that is (filling, turning, writing), SIGKILL the
+# driver and its workers; then the same command again.
+for target in 0 1 3 4 6; do
+  "$bin" "${args[@]}" --out "$work/killed" > "$work/killed.$target.log" 2>&1 &
   pid=$!
-  sleep "$delay"
-  pkill -KILL -P "$pid" 2>/dev/null || true   # the worker processes first, then the driver
+  while kill -0 "$pid" 2>/dev/null && [ "$(records)" -lt "$target" ]; do sleep 0.5; done
+  sleep 2
+  pkill -KILL -P "$pid" 2>/dev/null || true   # the worker processes, then the driver
   kill -KILL "$pid" 2>/dev/null || true
   wait "$pid" 2>/dev/null || true
-  n=$(ls "$work/killed/store" 2>/dev/null | grep -c '\.yaml$' || true)
-  echo "killed after ${delay} s: ${n} records stored"
-  # No record is ever half-written: each one parses (a damaged one would make the rerun fail).
+  echo "killed once ${target}+ records were stored, 2 s later: $(records) stored"
 done
 before=$(ls "$work/killed/store" | grep -c '\.yaml$')
 stamp=$(mktemp)
@@ -28,6 +30,7 @@ stamp=$(mktemp)
 diff "$work/whole/calibrated_parameters.csv" "$work/killed/calibrated_parameters.csv"
 ran=$(sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/resume.log")
 echo "resume: ${before} of ${total} records were stored before it; it ran ${ran}"
+[ "$before" -gt 0 ] || { echo "no record survived the kills: the test did not test resuming"; exit 1; }
 [ "$ran" -eq $((total - before)) ] || { echo "the resume reran stored simulations"; exit 1; }
 # Stored records were not rewritten by the resume.
 changed=$(find "$work/killed/store" -name '*.yaml' ! -newer "$stamp" | wc -l)
