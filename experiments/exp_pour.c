@@ -46,8 +46,11 @@ size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_
                 size_t k = next + placed;
                 dem_vec3 p = dem_v3(x, y, z);
                 if (!region->inside(p, region->ctx) || overlaps(w, p, 0.5 * diam[k], y0 - pitch)) continue;
-                // A small sideways velocity so layers do not stack in columns.
-                dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0);
+                // A small sideways velocity so layers do not stack in columns, with
+                // a component along z too: without it a drum bed poured on lattice
+                // planes z = const stays in them (every contact normal lies in the
+                // plane), a stack of uncoupled 2D monolayers (results/drum_geometry).
+                dem_vec3 v = dem_v3(0.05 * sin(1.3 * (double)k), -0.1, 0.05 * cos(1.7 * (double)k));
                 if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], density) < 0) return placed;
                 placed++;
             }
