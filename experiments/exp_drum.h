@@ -60,8 +60,6 @@ typedef struct exp_drum_measure {
 int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px,
                          exp_drum_measure *out);
 
-#endif
-
 /// How a rotation run decides it is done.
 typedef struct exp_drum_run_opts {
     double rpm;
@@ -90,3 +88,5 @@ typedef struct exp_drum_result {
 /// the engine status; a fault is recorded in the result as not steady.
 dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
                            void *ctx, exp_drum_result *out);
+
+#endif
