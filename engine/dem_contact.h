@@ -88,6 +88,10 @@ typedef struct dem_contact_out {
     dem_vec3 f_rolling;    ///< rolling quasi-force F_ij,r
     double normal_force;   ///< signed magnitude along −n_ij (> 0 repulsive)
     double damping_coeff;  ///< γ_n the dashpot applied this step (0 if off, or clamped away)
+    /// Stiffness of the tangential / rolling spring for the implicit spring
+    /// solve: k while the spring sticks, 0 while it slides (a Coulomb-limited
+    /// force, eq. 8 and 13, has no stiffness) or when the spring is off.
+    double k_tangential, k_rolling;
 } dem_contact_out;
 
 /// Doubles of history a contact needs for the given feature mask.
@@ -130,13 +134,15 @@ static inline dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twis
 /// Advance one history spring by its relative velocity and apply the Coulomb
 /// limit: F = −k·δ, |F| ≤ μ|F_n|; on truncation the spring is reset so that
 /// k|δ| equals the limit (eq. 6+8 for sliding, eq. 11+13 for rolling).
+/// `*sticking` becomes 1 if the spring stayed below the limit.
 static inline dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist, dem_vec3 vel, double dt,
-                                         double k, double inv_k, double limit)
+                                         double k, double inv_k, double limit, int *sticking)
 {
     dem_vec3 spring = dem_spring_carry(dem_v3(hist[0], hist[1], hist[2]), n, twist);
     spring = dem_v3_axpy(dt, vel, spring);
     dem_vec3 force = dem_v3_scale(spring, -k);
     double f2 = dem_v3_norm2(force);
+    *sticking = !(f2 > limit * limit);
     if (f2 > limit * limit) {
         force = dem_v3_scale(force, limit / sqrt(f2));
         spring = dem_v3_scale(force, -inv_k);
@@ -171,11 +177,14 @@ static inline void dem_contact_eval(const dem_contact_coeffs *c, const dem_conta
     out->normal_force = fn;
     out->force = dem_v3_scale(n, -fn);
     const double fn_abs = fabs(fn);
-    int slot = 0;
+    int slot = 0, stick = 0;
+    out->k_tangential = out->k_rolling = 0.0;
     if (features & DEM_FEAT_TANGENTIAL) {
         // Eq. 7: tangential part of the contact-point relative velocity.
         dem_vec3 vt = dem_v3_axpy(-vn, n, s->vrel);
-        out->f_tangential = dem_spring_update(hist, n, s->twist, vt, s->dt, c->k_s, c->inv_k_s, c->mu_s * fn_abs);
+        out->f_tangential =
+            dem_spring_update(hist, n, s->twist, vt, s->dt, c->k_s, c->inv_k_s, c->mu_s * fn_abs, &stick);
+        out->k_tangential = stick ? c->k_s : 0.0;
         out->force = dem_v3_add(out->force, out->f_tangential);
         slot += 3;
     } else {
@@ -184,7 +193,9 @@ static inline void dem_contact_eval(const dem_contact_coeffs *c, const dem_conta
     if (features & DEM_FEAT_ROLLING) {
         // Eq. 12: v_rel,r = −R* (ω_i − ω_j) × n.
         dem_vec3 vr = dem_v3_scale(dem_v3_cross(s->wrel, n), -s->reduced_radius);
-        out->f_rolling = dem_spring_update(hist + slot, n, s->twist, vr, s->dt, c->k_r, c->inv_k_r, c->mu_r * fn_abs);
+        out->f_rolling =
+            dem_spring_update(hist + slot, n, s->twist, vr, s->dt, c->k_r, c->inv_k_r, c->mu_r * fn_abs, &stick);
+        out->k_rolling = stick ? c->k_r : 0.0;
     } else {
         out->f_rolling = dem_v3(0, 0, 0);
     }

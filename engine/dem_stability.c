@@ -53,9 +53,17 @@ static size_t collect_contacts(dem_world *w, contact_geo **out)
     return m;
 }
 
-// y = K x (stiffness) or y = C x (normal dashpots), mass-normalised.
-static void apply(const dem_world *w, const contact_geo *c, size_t m, const dof6 *x, dof6 *y, int dashpot)
+// Which linearised operator `apply` forms.
+enum op_kind {
+    OP_STIFFNESS = 0, // K: normal, sticking tangential and rolling springs
+    OP_DASHPOT = 1,   // C: normal dashpots
+    OP_NORMAL = 2,    // K_n: normal springs alone
+};
+
+// y = K x, C x or K_n x, mass-normalised.
+static void apply(const dem_world *w, const contact_geo *c, size_t m, const dof6 *x, dof6 *y, enum op_kind op)
 {
+    const int dashpot = op == OP_DASHPOT;
     memset(y, 0, w->n * sizeof *y);
     for (size_t k = 0; k < m; ++k) {
         const contact_geo *g = &c[k];
@@ -70,6 +78,8 @@ static void apply(const dem_world *w, const contact_geo *c, size_t m, const dof6
         dem_vec3 f, torque_i = dem_v3(0, 0, 0), torque_j = dem_v3(0, 0, 0);
         if (dashpot) {
             f = dem_v3_scale(n, 2 * g->p->xi * sqrt(g->mstar * g->p->k_n) * dem_v3_dot(du, n));
+        } else if (op == OP_NORMAL) {
+            f = dem_v3_scale(n, g->p->k_n * dem_v3_dot(du, n));
         } else {
             f = dem_v3_scale(n, g->p->k_n * dem_v3_dot(du, n));
             dem_vec3 slip = dem_v3_add(dem_v3_axpy(-dem_v3_dot(du, n), n, du),
@@ -99,7 +109,7 @@ static double dot6(const dof6 *a, const dof6 *b, size_t n)
 }
 
 // Largest eigenvalue of a symmetric positive semi-definite operator.
-static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_t m, int dashpot)
+static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_t m, enum op_kind op)
 {
     size_t n = w->n;
     dof6 *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
@@ -118,7 +128,7 @@ static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_
         double norm = sqrt(dot6(x, x, n));
         if (norm == 0) break;
         for (size_t k = 0; k < 6 * n; ++k) xs[k] /= norm;
-        apply(w, c, m, x, y, dashpot);
+        apply(w, c, m, x, y, op);
         double next = dot6(x, y, n); // Rayleigh quotient
         dof6 *t = x;
         x = y, y = t, xs = (double *)x;
@@ -132,6 +142,36 @@ static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_
     return lambda;
 }
 
+static int switches(const dem_contact_params *p) { return p->xi > 0 && p->damping != DEM_DAMPING_ALWAYS; }
+
+// Whether any dashpot of the world is switched on and off within a contact.
+static int dashpot_switches(const dem_world *w)
+{
+    int s = switches(&w->def.granule);
+    for (int k = 0; k < w->n_walls; ++k) s |= switches(&w->walls[k].def.contact);
+    return s;
+}
+
+// Implicit springs (dem_world_def.implicit_springs): the limit is the normal
+// springs' own, ω_n·Δt < 2 (proof in dem_stability.h); the sticking
+// tangential and rolling springs and the dashpots do not enter it.
+static dem_stability limit_implicit_springs(const dem_world *w, const contact_geo *c, size_t m, double dt_crit)
+{
+    dem_stability st = {0};
+    st.dt_crit = dt_crit;
+    double k = m ? largest_eigenvalue(w, c, m, OP_NORMAL) : 0;
+    // A dashpot switched by the sign of v_rel,n (eq. 4 read as approaching or
+    // separating; no_tension switches it off at zero force) pumps the mode
+    // once it turns by more than 120° a step: ω_n·Δt < √3, for any ξ
+    // (measured on one contact; 2 for a dashpot that never switches).
+    const double bound = dashpot_switches(w) ? sqrt(3.0) : 2.0;
+    st.omega_max = sqrt(k > 0 ? k : 0);
+    st.dt_limit = st.omega_max > 0 ? bound / st.omega_max : DBL_MAX;
+    snprintf(st.why, sizeof st.why, "%zu contacts; implicit springs: %s/omega_n, omega_n = %.4g rad/s", m,
+             bound < 2.0 ? "sqrt(3)" : "2", st.omega_max);
+    return st;
+}
+
 dem_stability dem_stability_of_network(dem_world *w, double dt_crit)
 {
     dem_stability st = {0};
@@ -142,9 +182,14 @@ dem_stability dem_stability_of_network(dem_world *w, double dt_crit)
     }
     contact_geo *c = NULL;
     size_t m = collect_contacts(w, &c);
+    if (w->def.implicit_springs) {
+        st = limit_implicit_springs(w, c, m, dt_crit);
+        free(c);
+        return st;
+    }
     // With the implicit dashpot the dashpot leaves the limit: ω·dt < 2.
-    double k = m ? largest_eigenvalue(w, c, m, 0) : 0;
-    double d = m && !w->def.implicit_damping ? largest_eigenvalue(w, c, m, 1) : 0;
+    double k = m ? largest_eigenvalue(w, c, m, OP_STIFFNESS) : 0;
+    double d = m && !w->def.implicit_damping ? largest_eigenvalue(w, c, m, OP_DASHPOT) : 0;
     free(c);
     st.omega_max = sqrt(k > 0 ? k : 0);
     st.damping_max = d > 0 ? d : 0;
@@ -167,6 +212,8 @@ static dem_contact_params stiffest(const dem_world *w)
         p.k_r = fmax(p.k_r, 0.5 * q->k_r);
         p.xi = fmax(p.xi, q->xi);
     }
+    // A switching wall dashpot bounds the implicit-spring step like one of the granules'.
+    if (dashpot_switches(w) && p.damping == DEM_DAMPING_ALWAYS) p.damping = DEM_DAMPING_APPROACHING;
     return p;
 }
 
@@ -193,6 +240,7 @@ dem_stability dem_stability_apriori(const dem_world *w)
     def.granule.mu_s = def.granule.mu_r = 1e300;
     def.lever_arm = w->def.lever_arm;
     def.implicit_damping = w->def.implicit_damping;
+    def.implicit_springs = w->def.implicit_springs;
     def.domain_lo = dem_v3(-r_min, -r_min, -r_min);
     def.domain_hi = dem_v3_scale(dem_v3(1, 1, 1), 2 * r_min * (LATTICE_CELLS * 1.5 + 1));
     dem_world *lat = dem_world_create(&def, NULL, 0);

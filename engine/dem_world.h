@@ -55,6 +55,9 @@ typedef struct dem_wall_def {
     const char *name; ///< for messages, optional
 } dem_wall_def;
 
+/// dem_world_def.implicit_springs: decided by dem_world_prepare.
+#define DEM_IMPLICIT_AUTO (-1)
+
 /// Definition of a world, with defaults from dem_default_world_def().
 typedef struct dem_world_def {
     dem_vec3 gravity;               ///< m/s², default (0, −9.81, 0)
@@ -73,6 +76,22 @@ typedef struct dem_world_def {
     /// the stability limit (left: the spring modes, ω·Δt < 2). Default 0
     /// (explicit, as in LIGGGHTS) while it is being validated.
     int implicit_damping;
+    /// Implicit springs (the engine issue's semi-implicit update): the
+    /// sticking tangential and rolling springs (eq. 6, 11) are integrated by
+    /// Newmark's average-acceleration rule (β = 1/4) and the normal dashpots
+    /// (eq. 3–4) by backward Euler, both solved over the whole contact network
+    /// each step: (M + Δt·C + Δt²/4·K_t)·a = F + M·g, by conjugate gradients
+    /// preconditioned with each granule's own 6×6 block (v, ω) of that
+    /// matrix. Normal springs stay explicit (velocity Verlet), so collisions
+    /// keep their explicit accuracy. Proven limit (dem_stability.h): the
+    /// normal springs' own ω_n·Δt < √3 (2 for a dashpot that never switches);
+    /// the spin mode leaves it. 1: on (overrides implicit_damping: its
+    /// dashpot is part of this solve); 0: off; DEM_IMPLICIT_AUTO (default):
+    /// on for a configured dt above the explicit integration's own limit
+    /// (e.g. the paper's 0.6 dt_crit, which is then run instead of refused),
+    /// unless implicit_damping is set; otherwise explicit, bit for bit as
+    /// before (a step left to the engine, the Table A.1 verification).
+    int implicit_springs;
     /// Accept a configured dt above the stability limit. Only for studies of
     /// the limit itself (tests/stability); never set by configs.
     int allow_unstable_dt;
@@ -160,6 +179,10 @@ double dem_world_time(const dem_world *w);
 double dem_world_dt(const dem_world *w);
 /// The stability limit found by dem_world_prepare (s); 0 before it.
 double dem_world_dt_limit(const dem_world *w);
+/// Whether the world steps with implicit springs (decided by dem_world_prepare).
+int dem_world_implicit_springs(const dem_world *w);
+/// Mean conjugate-gradient iterations per step of the implicit spring solve.
+double dem_world_implicit_iterations(const dem_world *w);
 unsigned dem_world_features(const dem_world *w);
 const char *dem_world_error(const dem_world *w);
 /// Human-readable line on how the time step was chosen.

@@ -33,6 +33,32 @@ typedef struct dem_wall {
     double *hist; // hist_len doubles per granule
 } dem_wall;
 
+// One contact as the implicit spring solve sees it (dem_forces.c): normal,
+// dashpot γ applied, stiffness of the sticking tangential and rolling springs
+// (0 while sliding), lever arms and R*. All zero for an open contact.
+typedef struct dem_imp_contact {
+    dem_vec3 n;
+    double g, kt, kr, ai, aj, rs;
+} dem_imp_contact;
+
+// Scratch of the implicit spring solve, allocated on first use.
+typedef struct dem_imp_scratch {
+    dem_imp_contact *pair; // per neighbour-list pair
+    dem_vec3 *pf, *pti, *ptj; // per pair: operator output (force on i, torques on i and j)
+    double *wall;  // per granule, 36: walls' part of the diagonal block
+    double *chol;  // per granule, 36: Cholesky factor of the diagonal block (preconditioner)
+    double *b, *r, *z, *p, *q; // per granule, 6 each
+    double *partial;           // per chunk, for reproducible dot products
+    size_t pair_cap, cap, chunk_cap;
+    int on; // implicit springs on and scratch in place for this force evaluation
+} dem_imp_scratch;
+
+// Statistics of the implicit spring solve (conjugate-gradient iterations).
+typedef struct dem_imp_stats {
+    uint64_t solves, iterations;
+    int max_iterations, last_iterations, unconverged;
+} dem_imp_stats;
+
 struct dem_world {
     dem_world_def def;
 
@@ -59,6 +85,12 @@ struct dem_world {
     dem_vec3 *pair_n;  // contact normal, for the implicit dashpot
     double *pair_g;    // dashpot coefficient applied, for the implicit dashpot
     double *damp;      // per granule, 6 doubles: Σγ n nᵀ (xx yy zz xy xz yz)
+    // Implicit springs: per granule, the velocity and spin rates the solve
+    // found (6 doubles: dv/dt, dω/dt), used by both half kicks; and scratch.
+    double *acc;
+    int springs_requested; // dem_world_def.implicit_springs as given (may be auto)
+    dem_imp_scratch imp;
+    dem_imp_stats imp_stats;
     size_t pair_cap;
     size_t *rev_start, *rev_pair;
     dem_vec3 *pos_at_build;
@@ -111,6 +143,10 @@ dem_vec3 dem_world_min_image(const dem_world *w, dem_vec3 d);
 
 // dem_forces.c
 void dem_forces_compute(dem_world *w);
+// Implicit springs: solve (M + Δt C + Δt²/4 K_t) a = F + M g for every
+// granule's rates a (into w->acc); 0 on success, 1 out of memory.
+int dem_implicit_solve(dem_world *w);
+void dem_imp_scratch_free(dem_imp_scratch *s);
 
 // dem_world.c
 int dem_world_set_error(dem_world *w, const char *fmt, ...);

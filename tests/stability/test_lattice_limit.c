@@ -4,7 +4,8 @@
 // periodic along x, perturbed. At the engine's default step the lattice
 // returns to rest; run above the limit the engine computes, it blows up, so
 // the limit is real and not just a safe-looking number; a configured step
-// above it is refused before the run starts.
+// above it is refused before the run starts. Three integrations: explicit,
+// implicit dashpot, implicit springs (limit √3/ω_n of the normal springs).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,12 +23,15 @@
 #define CELLS 4
 #define PRESTRESS 1e-3 // overlap / diameter of nearest neighbours
 
-static int implicit_damping; // the dashpot integration under test
+// The integration under test: 0 explicit, 1 implicit dashpot, 2 implicit
+// springs (Newmark β = 1/4 on the sticking springs, network solve).
+static int integration;
 
 static dem_world_def lattice_def(double dt, int allow)
 {
     dem_world_def def = dem_default_world_def();
-    def.implicit_damping = implicit_damping;
+    def.implicit_damping = integration == 1;
+    def.implicit_springs = integration == 2;
     double a = 2 * R * (1 - PRESTRESS) * sqrt(2.0);
     def.gravity = dem_v3(0, 0, 0);
     def.granule.mu_s = def.granule.mu_r = 1e6; // sticking: springs never truncate
@@ -135,8 +139,12 @@ static void test_limit_is_real(void **state)
     // be stable; far above it the spin mode must blow up, or the bound is
     // meaningless. Implicit dashpot: the limit is the spring modes' own,
     // ω·dt = 2, so it is sharp: stable just below, blowing up just above.
+    // Implicit springs: the limit is the normal springs' ω_n·dt = √3 (the
+    // switched dashpot of eq. 4 pumps a mode turning > 120° a step): stable
+    // at 0.95 of it, blowing up at 1.3 (0.82 dt_crit).
     const double explicit_factors[] = {1.0, 1.6, 2.5}, implicit_factors[] = {0.95, 1.0, 1.1};
-    const double *factors = implicit_damping ? implicit_factors : explicit_factors;
+    const double spring_factors[] = {0.95, 1.1, 1.3};
+    const double *factors = integration == 2 ? spring_factors : integration ? implicit_factors : explicit_factors;
     double worst[3];
     for (size_t k = 0; k < 3; ++k) {
         dem_world *w = make_lattice(factors[k] * limit, 1);
@@ -162,7 +170,7 @@ static void test_step_above_limit_refused(void **state)
 static int explicit_dashpot(void **state)
 {
     (void)state;
-    implicit_damping = 0;
+    integration = 0;
     printf("-- explicit dashpot\n");
     return 0;
 }
@@ -170,8 +178,16 @@ static int explicit_dashpot(void **state)
 static int implicit_dashpot(void **state)
 {
     (void)state;
-    implicit_damping = 1;
+    integration = 1;
     printf("-- implicit dashpot\n");
+    return 0;
+}
+
+static int implicit_springs(void **state)
+{
+    (void)state;
+    integration = 2;
+    printf("-- implicit springs\n");
     return 0;
 }
 
@@ -181,5 +197,6 @@ int main(void)
                                        cmocka_unit_test(test_limit_is_real),
                                        cmocka_unit_test(test_step_above_limit_refused)};
     int failed = cmocka_run_group_tests_name("explicit dashpot", tests, explicit_dashpot, NULL);
-    return failed + cmocka_run_group_tests_name("implicit dashpot", tests, implicit_dashpot, NULL);
+    failed += cmocka_run_group_tests_name("implicit dashpot", tests, implicit_dashpot, NULL);
+    return failed + cmocka_run_group_tests_name("implicit springs", tests, implicit_springs, NULL);
 }
