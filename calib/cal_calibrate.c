@@ -289,7 +289,7 @@ static int calibrate(run *r, const char *command)
 {
     double k_n, gg_mu_s, gg_mu_r;
     const char *k_source, *gg_source;
-    r->env.started = cal_wall_seconds();
+    r->env.started = exp_wall_seconds();
     if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
         stage_walls(r, k_n, gg_mu_s, gg_mu_r))
         return 1;
@@ -298,7 +298,7 @@ static int calibrate(run *r, const char *command)
     if (cal_mpi_rank() != 0) return 0;
     cal_outcome o = {.config = r->c, .tier = r->t, .stiffness = wants(r, "stiffness") ? &r->stiffness : NULL,
                      .granule = r->granule, .n_walls = r->n_walls, .table = r->table, .command = command,
-                     .wall_time_s = cal_wall_seconds() - r->env.started, .ranks = cal_mpi_size(), .workers = r->env.workers};
+                     .wall_time_s = exp_wall_seconds() - r->env.started, .ranks = cal_mpi_size(), .workers = r->env.workers};
     for (int w = 0; w < r->n_walls; ++w) o.walls[w] = r->walls[w];
     if (cal_report_write(r->out, &o, r->err, sizeof r->err)) return 1;
     print_table(r->out);

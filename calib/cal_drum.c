@@ -7,6 +7,7 @@
 
 #include "cal_commands.h"
 #include "cal_util.h"
+#include "exp_common.h"
 #include "dem_output.h"
 #include "exp_drum_config.h"
 #include "exp_image.h"
@@ -19,7 +20,7 @@ typedef struct progress_state {
 static void show_progress(const char *phase, double t, size_t granules, void *ctx)
 {
     progress_state *p = ctx;
-    double now = cal_wall_seconds();
+    double now = exp_wall_seconds();
     if (now - p->last_wall < (p->tty ? 0.5 : 10.0)) return;
     p->last_wall = now;
     fprintf(stderr, p->tty ? "\r%-6s t = %6.3f s  granules %zu  wall %6.0f s   " : "%s t = %.3f s granules %zu wall %.0f s\n",
@@ -95,10 +96,10 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
         return 1;
     }
     run.rpm = y->rpm = rpm;
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     exp_drum_result r;
     dem_status st = exp_drum_rotate(w, def, &run, show_progress, p, &r);
-    r.wall_time_s = cal_wall_seconds() - t0;
+    r.wall_time_s = exp_wall_seconds() - t0;
     if (p->tty) fputc('\n', stderr);
     const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: %g rpm: %s\n", rpm, dem_world_error(w));
@@ -123,7 +124,7 @@ int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out
     exp_drum_config_defs(y, &def, &run, err, sizeof err);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/drum");
     if (cal_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), exp_drum_config_free(y), 1;
-    progress_state p = {isatty(2), 0, cal_wall_seconds()};
+    progress_state p = {isatty(2), 0, exp_wall_seconds()};
     dem_world *bed = exp_drum_fill(&def, show_progress, &p, err, sizeof err);
     if (!bed) return fprintf(stderr, "\ngranucal simulate: %s\n", err), exp_drum_config_free(y), 1;
     fprintf(stderr, "%sgranucal simulate: bed of %zu granules settled after %.2f s; %s\n", p.tty ? "\n" : "",

@@ -84,7 +84,7 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
 
 static void show_done(const cal_env *env, const char *what, const cal_record *r)
 {
-    double wall = cal_wall_seconds() - env->started;
+    double wall = exp_wall_seconds() - env->started;
     if (env->tty) fputs("\r\033[K", stderr);
     fprintf(stderr, "[%s] %s: %s", env->stage, what, r->status);
     if (r->reason && r->reason[0]) fprintf(stderr, " (%s)", r->reason);
@@ -134,7 +134,7 @@ static int turn_one(int i, void *ctx)
     // In a forked child the bed is this process's own copy; inline, turn a clone.
     dem_world *w = b->env->use_fork ? b->bed : dem_world_clone(b->bed);
     if (!w) return write_failed(b->env, b->keys[k], "out of memory copying the settled bed"), 1;
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     exp_drum_result res;
     dem_status st = exp_drum_rotate(w, &b->c->def, &run, NULL, NULL, &res);
     cal_record r = {.key = b->keys[k], .reason = ""};
@@ -143,7 +143,7 @@ static int turn_one(int i, void *ctx)
     r.angle_deg = res.angle_deg, r.angle_sd_deg = res.angle_sd_deg;
     r.csa_percent = res.csa_percent, r.csa_sd_percent = res.csa_sd_percent;
     r.steady = res.steady, r.simulated_time_s = res.simulated_time_s;
-    r.wall_time_s = cal_wall_seconds() - t0 + b->bed_wall_s; // the bed's cost is shared by every speed
+    r.wall_time_s = exp_wall_seconds() - t0 + b->bed_wall_s; // the bed's cost is shared by every speed
     r.dt_s = dem_world_dt(w), r.particle_steps = (double)res.particle_steps, r.granules = (int)res.granules;
     char err[512];
     int bad = cal_store_put(b->env->store, &r, err, sizeof err);
@@ -152,32 +152,40 @@ static int turn_one(int i, void *ctx)
     return bad;
 }
 
+// A worker ended: a process killed by a signal wrote nothing, so record it
+// as failed; then show what the record holds.
+static void finish_task(cal_env *env, const char *key, const char *what, int code)
+{
+    char err[512];
+    if (code < 0) {
+        char reason[64];
+        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
+        write_failed(env, key, reason);
+    }
+    cal_record r;
+    if (cal_store_get(env->store, key, &r, err, sizeof err) == 0) {
+        show_done(env, what, &r);
+        cal_record_free(&r);
+    }
+    env->simulations_run++;
+}
+
 static void turned(int i, int code, void *ctx)
 {
     drum_batch *b = ctx;
     int k = b->todo[i];
-    char what[64], err[512];
+    char what[64];
     snprintf(what, sizeof what, "%g rpm", b->rpm[k]);
-    if (code < 0) { // killed by a signal: the child wrote nothing
-        char reason[64];
-        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
-        write_failed(b->env, b->keys[k], reason);
-    }
-    cal_record r;
-    if (cal_store_get(b->env->store, b->keys[k], &r, err, sizeof err) == 0) {
-        show_done(b->env, what, &r);
-        cal_record_free(&r);
-    }
-    b->env->simulations_run++;
+    finish_task(b->env, b->keys[k], what, code);
 }
 
 // Fill this rank's bed and turn it at each of its missing speeds.
 static void run_missing_drum(drum_batch *b, int n_todo)
 {
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     char err[1024];
     b->bed = exp_drum_fill(&b->c->def, NULL, NULL, err, sizeof err);
-    b->bed_wall_s = cal_wall_seconds() - t0;
+    b->bed_wall_s = exp_wall_seconds() - t0;
     if (!b->bed) {
         for (int i = 0; i < n_todo; ++i) write_failed(b->env, b->keys[b->todo[i]], err);
         return;
@@ -224,7 +232,7 @@ static int pour_one(int i, void *ctx)
 {
     cylinder_batch *b = ctx;
     int k = b->todo[i];
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     char err[1024];
     exp_cylinder_result res;
     dem_world *w = exp_cylinder_run(&b->cases[k], NULL, NULL, &res, err, sizeof err);
@@ -232,7 +240,7 @@ static int pour_one(int i, void *ctx)
     cal_record r = {.key = b->keys[k], .status = "ok", .reason = ""};
     r.coordination = res.coordination, r.coordination_interior = res.coordination_interior;
     r.wall_contacts_per_granule = res.wall_contacts_per_granule, r.solid_fraction = res.solid_fraction;
-    r.steady = 1, r.simulated_time_s = res.simulated_time_s, r.wall_time_s = cal_wall_seconds() - t0;
+    r.steady = 1, r.simulated_time_s = res.simulated_time_s, r.wall_time_s = exp_wall_seconds() - t0;
     r.dt_s = dem_world_dt(w), r.granules = (int)res.granules;
     dem_world_destroy(w);
     int bad = cal_store_put(b->env->store, &r, err, sizeof err);
@@ -244,20 +252,10 @@ static void poured(int i, int code, void *ctx)
 {
     cylinder_batch *b = ctx;
     int k = b->todo[i];
-    char what[96], err[512];
-    if (code < 0) {
-        char reason[64];
-        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
-        write_failed(b->env, b->keys[k], reason);
-    }
+    char what[96];
     snprintf(what, sizeof what, "cylinder k_n = %g N/m, seed %llu", b->cases[k].granule.k_n,
              (unsigned long long)b->cases[k].seed);
-    cal_record r;
-    if (cal_store_get(b->env->store, b->keys[k], &r, err, sizeof err) == 0) {
-        show_done(b->env, what, &r);
-        cal_record_free(&r);
-    }
-    b->env->simulations_run++;
+    finish_task(b->env, b->keys[k], what, code);
 }
 
 int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len)

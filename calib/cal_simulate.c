@@ -8,6 +8,7 @@
 
 #include "cal_commands.h"
 #include "cal_util.h"
+#include "exp_common.h"
 #include "dem_output.h"
 #include "exp_compress.h"
 #include "exp_drum_config.h"
@@ -172,10 +173,10 @@ int cal_cmd_simulate(int argc, char **argv)
         fprintf(stderr, "granucal simulate: %s\n", err);
     } else {
         fprintf(stderr, "granucal simulate: %s\n", dem_world_dt_report(w));
-        double t0 = cal_wall_seconds();
+        double t0 = exp_wall_seconds();
         uint64_t steps = 0;
         dem_status st = run_scene(s, w, &o, &steps);
-        rc = finish(dir, &o, s, w, st, steps, cal_wall_seconds() - t0);
+        rc = finish(dir, &o, s, w, st, steps, exp_wall_seconds() - t0);
     }
     dem_world_destroy(w);
     exp_scene_free(s);

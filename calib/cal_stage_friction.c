@@ -72,7 +72,7 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
 static void show_start(const search *s, double mu_s, double mu_r)
 {
     int planned = s->t->grid * s->t->grid + s->t->max_evaluations, done = s->r->n;
-    double spent = cal_wall_seconds() - s->started;
+    double spent = exp_wall_seconds() - s->started;
     char eta[48] = "";
     if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
     fprintf(stderr, "%s[%s] candidate %d of at most %d: mu_s = %.4g, mu_r = %.4g (%d speeds%s)%s", s->env->tty ? "\r\033[K" : "",
@@ -90,7 +90,7 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     cal_drum_case dc = s->material ? cal_drum_case_make(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
                                    : cal_drum_case_make(s->c, s->t, r->k_n, mu_s, mu_r, mu_s, mu_r);
     cal_record rec[CAL_MAX_RPM];
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     show_start(s, mu_s, mu_r);
     if (cal_drum_evaluate(s->env, &dc, s->sim_rpm, s->n_sim, rec, s->err, s->len)) {
         s->failed = 1;
@@ -101,7 +101,7 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     k->mu_s = mu_s, k->mu_r = mu_r, k->from_grid = from_grid;
     score(s, k, rec);
     for (int i = 0; i < s->n_sim; ++i) k->wall_time_s += rec[i].wall_time_s, cal_record_free(&rec[i]);
-    double elapsed = cal_wall_seconds() - t0;
+    double elapsed = exp_wall_seconds() - t0;
     fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g (%.0f s)\n",
             s->env->tty ? "\r\033[K" : "", s->env->stage, r->n, mu_s, mu_r, k->angle_deg, r->angle_target,
             r->angle_tolerance, k->misfit, elapsed);
@@ -206,7 +206,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
                        double gg_mu_r, cal_friction_result *out, char *err, size_t len)
 {
     memset(out, 0, sizeof *out);
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     snprintf(out->material, sizeof out->material, "%s", material ? material->name : "");
     snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
     out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
@@ -220,7 +220,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
     out->best = best_of(out);
     out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
-    out->wall_time_s = cal_wall_seconds() - t0;
+    out->wall_time_s = exp_wall_seconds() - t0;
     if (s.failed) return 1;
     if (out->best < 0) return exp_fail(err, len, "%s: every candidate failed; see simulations.csv", stage);
     return 0;

@@ -62,7 +62,7 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
                         size_t len)
 {
     memset(out, 0, sizeof *out);
-    double t0 = cal_wall_seconds();
+    double t0 = exp_wall_seconds();
     int seeds = t->seeds, n = (int)c->stiffness_count;
     if (n > CAL_MAX_K) return exp_fail(err, len, "at most %d stiffness candidates", CAL_MAX_K);
     exp_cylinder_def *cases = calloc((size_t)(n * seeds), sizeof *cases);
@@ -87,6 +87,6 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
     }
     for (int i = 0; i < n * seeds; ++i) cal_record_free(&rec[i]);
     free(cases), free(rec);
-    out->wall_time_s = cal_wall_seconds() - t0;
+    out->wall_time_s = exp_wall_seconds() - t0;
     return bad;
 }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "cal_util.h"
 
+#include "exp_common.h"
+
 #include <errno.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -9,20 +11,10 @@
 
 int cal_mkdirs(const char *path, char *err, size_t err_len)
 {
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *p = buf + 1; *p; ++p) {
-        if (*p != '/') continue;
-        *p = '\0';
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) goto fail;
-        *p = '/';
-    }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST) goto fail;
-    if (access(buf, W_OK) != 0) goto fail;
+    if (exp_mkdirs(path, err, err_len)) return 1;
+    if (access(path, W_OK) != 0)
+        return snprintf(err, err_len, "cannot write in directory '%s': %s", path, strerror(errno)), 1;
     return 0;
-fail:
-    snprintf(err, err_len, "cannot create or write directory '%s': %s", buf, strerror(errno));
-    return 1;
 }
 
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len)
@@ -57,9 +49,3 @@ void cal_atomic_abort(cal_atomic_file *a)
     unlink(a->tmp);
 }
 
-double cal_wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}

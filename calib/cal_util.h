@@ -7,7 +7,8 @@
 
 #include <stdio.h>
 
-/// Create a directory and its parents; 0 on success, else a message.
+/// Create a directory and its parents (exp_mkdirs) and check that it is
+/// writable; 0 on success, else a message.
 int cal_mkdirs(const char *path, char *err, size_t err_len);
 
 /// A file written under a temporary name and renamed into place on commit,
@@ -21,7 +22,5 @@ int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_
 int cal_atomic_commit(cal_atomic_file *a, char *err, size_t err_len);
 void cal_atomic_abort(cal_atomic_file *a);
 
-/// Seconds of wall-clock time since an arbitrary origin.
-double cal_wall_seconds(void);
 
 #endif

@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "exp_common.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 
 const char *exp_version(void) { return DEM_VERSION; }
 
@@ -13,4 +17,25 @@ int exp_fail(char *err, size_t len, const char *fmt, ...)
     vsnprintf(err, len, fmt, ap);
     va_end(ap);
     return 1;
+}
+
+double exp_wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int exp_mkdirs(const char *path, char *err, size_t len)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *p = buf + 1;; ++p) {
+        if (*p && *p != '/') continue;
+        char c = *p;
+        *p = '\0';
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return exp_fail(err, len, "cannot create '%s': %s", buf, strerror(errno));
+        if (!c) return 0;
+        *p = c;
+    }
 }

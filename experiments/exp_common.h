@@ -16,4 +16,10 @@ typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, vo
 /// every loader and builder here.
 int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
+/// Seconds of wall-clock time (monotonic) since an arbitrary origin.
+double exp_wall_seconds(void);
+
+/// Create a directory and its parents (like mkdir -p); 0, or 1 with a message.
+int exp_mkdirs(const char *path, char *err, size_t len);
+
 #endif

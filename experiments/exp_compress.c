@@ -534,27 +534,6 @@ int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_de
     return 0;
 }
 
-static double wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int make_dirs(const char *path, char *err, size_t len)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *p = buf + 1;; ++p) {
-        if (*p && *p != '/') continue;
-        char c = *p;
-        *p = '\0';
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return exp_fail(err, len, "cannot create '%s': %s", buf, strerror(errno));
-        if (!c) return 0;
-        *p = c;
-    }
-}
-
 typedef struct progress_state {
     double last, start;
 } progress_state;
@@ -562,7 +541,7 @@ typedef struct progress_state {
 static void show_progress(const char *phase, double t, size_t granules, void *ctx)
 {
     progress_state *p = ctx;
-    double now = wall_seconds();
+    double now = exp_wall_seconds();
     if (now - p->last < 10.0) return;
     p->last = now;
     fprintf(stderr, "compression: %s t = %.4f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
@@ -631,12 +610,12 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
     compress_yaml *y = load_config(path, n_sets, sets, &d, err, sizeof err);
     if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/compression");
-    if (make_dirs(dir, err, sizeof err)) {
+    if (exp_mkdirs(dir, err, sizeof err)) {
         fprintf(stderr, "granucal simulate: %s\n", err);
         cyaml_free(&quiet, &compress_schema, y, 0);
         return 1;
     }
-    progress_state p = {0, wall_seconds()};
+    progress_state p = {0, exp_wall_seconds()};
     exp_compress_result r;
     dem_world *w = exp_compress_run(&d, show_progress, &p, &r, err, sizeof err);
     int rc = 1;
@@ -644,7 +623,7 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
         fprintf(stderr, "granucal simulate: %s\n", err);
         printf("{\"experiment\": \"compression\", \"status\": \"failed\", \"error\": \"%s\"}\n", err);
     } else {
-        double wall = wall_seconds() - p.start;
+        double wall = exp_wall_seconds() - p.start;
         fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));
         int bad = write_outputs(dir, y, &d, &r, w, wall);
         write_json(stdout, y, &d, &r, w, r.stable ? "ok" : "not stable", wall);

@@ -466,27 +466,6 @@ static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_sil
     return y;
 }
 
-static double wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int make_dirs(const char *path, char *err, size_t len)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *p = buf + 1;; ++p) {
-        if (*p && *p != '/') continue;
-        char c = *p;
-        *p = '\0';
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return exp_fail(err, len, "cannot create '%s': %s", buf, strerror(errno));
-        if (!c) return 0;
-        *p = c;
-    }
-}
-
 typedef struct progress_state {
     double last, start;
 } progress_state;
@@ -494,7 +473,7 @@ typedef struct progress_state {
 static void show_progress(const char *phase, double t, size_t granules, void *ctx)
 {
     progress_state *p = ctx;
-    double now = wall_seconds();
+    double now = exp_wall_seconds();
     if (now - p->last < 10.0) return;
     p->last = now;
     fprintf(stderr, "silo: %s t = %.2f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
@@ -532,12 +511,12 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     cyaml_free(&quiet, &silo_schema, y, 0);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/silo");
-    if (make_dirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    progress_state ps = {0, wall_seconds()};
+    if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    progress_state ps = {0, exp_wall_seconds()};
     size_t plate = 0;
     dem_world *w = exp_silo_prepare(&d, show_progress, &ps, &plate, err, sizeof err);
     if (!w) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    double fill_wall = wall_seconds() - ps.start;
+    double fill_wall = exp_wall_seconds() - ps.start;
     if (dem_world_prepare(w) != DEM_OK) {
         fprintf(stderr, "granucal simulate: silo: %s\n", dem_world_error(w));
         dem_world_destroy(w);
@@ -548,9 +527,9 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     fprintf(stderr, "granucal simulate: silo filled (%zu granules, %zu plate spheres) in %.0f s; %s\n",
             dem_world_granules(w).count - plate, plate, fill_wall, dem_world_dt_report(w));
     exp_silo_result r;
-    double t0 = wall_seconds();
+    double t0 = exp_wall_seconds();
     dem_status st = exp_silo_discharge(w, &d, plate, show_progress, &ps, &r);
-    r.wall_time_s = wall_seconds() - t0;
+    r.wall_time_s = exp_wall_seconds() - t0;
     r.fill_time_s = fill_wall;
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: silo: %s\n", dem_world_error(w));
     char prefix[1100];
