@@ -150,6 +150,8 @@ static int check_output(const char *dir, char *err, size_t len)
     if (cal_mkdirs(dir, err, len)) return 1;
     snprintf(probe, sizeof probe, "%s/store", dir);
     if (cal_mkdirs(probe, err, len)) return 1;
+    cal_atomic_sweep(probe); // what a killed earlier run was writing when it died
+    cal_atomic_sweep(dir);
     snprintf(probe, sizeof probe, "%s/.write_test.%ld", dir, (long)getpid());
     FILE *f = fopen(probe, "w");
     if (!f || fputs("x", f) < 0 || fclose(f) != 0)

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // PNG figures with cairo (see cal_plot.h).
 #include "cal_plot.h"
+#include "cal_util.h"
 
 #include <cairo.h>
 #include <math.h>
@@ -86,8 +87,8 @@ static void axes(cairo_t *cr, const frame *f, const char *title, const char *xl,
 static int finish(cairo_surface_t *s, cairo_t *cr, const char *path, char *err, size_t len)
 {
     cairo_destroy(cr);
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    char tmp[1300];
+    cal_temporary_name(path, tmp, sizeof tmp);
     cairo_status_t st = cairo_surface_write_to_png(s, tmp);
     cairo_surface_destroy(s);
     if (st != CAIRO_STATUS_SUCCESS || rename(tmp, path) != 0)

@@ -2,8 +2,10 @@
 // Fork pool (see cal_pool.h).
 #include "cal_pool.h"
 
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +20,15 @@ static int run_inline(int n, cal_task_fn task, cal_done_fn done, void *ctx)
     return failures;
 }
 
+/// In a fresh child: die with the parent. A driver killed with SIGKILL cannot
+/// stop its workers itself, and an orphan would go on writing into a store that
+/// the rerun is already using (and leave a temporary behind when it is killed).
+static void die_with_parent(pid_t parent)
+{
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(1); // the parent died before prctl took effect
+}
+
 static int exit_code_of(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status); }
 
 int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int workers, int use_fork)
@@ -28,10 +39,14 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
     if (!pids) return run_inline(n, task, done, ctx);
     int next = 0, running = 0, failures = 0;
     fflush(NULL); // no buffered output duplicated into the children
+    const pid_t parent = getpid();
     while (next < n || running > 0) {
         while (running < workers && next < n) {
             pid_t pid = fork();
-            if (pid == 0) _exit(task(next, ctx) ? 1 : 0);
+            if (pid == 0) {
+                die_with_parent(parent);
+                _exit(task(next, ctx) ? 1 : 0);
+            }
             if (pid < 0) { // no process to spare: run it here
                 int code = task(next, ctx);
                 failures += code != 0;

@@ -85,9 +85,9 @@ typedef struct h5_row {
 
 static int write_table_h5(const char *dir, const row *rows, int n, char *err, size_t len)
 {
-    char path[1200], tmp[1220];
+    char path[1200], tmp[1300];
     snprintf(path, sizeof path, "%s/calibrated_parameters.h5", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    cal_temporary_name(path, tmp, sizeof tmp);
     h5_row *data = calloc((size_t)n, sizeof *data);
     if (!data) return exp_fail(err, len, "out of memory");
     for (int i = 0; i < n; ++i) {

@@ -3,7 +3,10 @@
 
 #include "exp_common.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -17,10 +20,26 @@ int cal_mkdirs(const char *path, char *err, size_t err_len)
     return 0;
 }
 
+static void this_host(char host[64])
+{
+    snprintf(host, 64, "host");
+    gethostname(host, 63);
+    host[63] = 0;
+}
+
+void cal_temporary_name(const char *path, char *tmp, size_t len)
+{
+    // Per host and process: two ranks never share a temporary, and a later run can tell
+    // which temporaries belonged to a process that died (cal_atomic_sweep).
+    char host[64];
+    this_host(host);
+    snprintf(tmp, len, "%s.%s.%ld.tmp", path, host, (long)getpid());
+}
+
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len)
 {
     snprintf(a->path, sizeof a->path, "%s", path);
-    snprintf(a->tmp, sizeof a->tmp, "%s.%ld.tmp", path, (long)getpid()); // per process: two ranks never share a temporary
+    cal_temporary_name(path, a->tmp, sizeof a->tmp);
     a->f = fopen(a->tmp, "w");
     if (!a->f) {
         snprintf(err, err_len, "cannot write '%s': %s", a->tmp, strerror(errno));
@@ -49,3 +68,38 @@ void cal_atomic_abort(cal_atomic_file *a)
     unlink(a->tmp);
 }
 
+
+/// Parse "NAME.HOST.PID.tmp"; 1 and the pid when the host is this one.
+static int temporary_of_this_host(const char *name, const char *host, long *pid)
+{
+    size_t n = strlen(name);
+    if (n < 5 || strcmp(name + n - 4, ".tmp") != 0) return 0;
+    const char *end = name + n - 4, *dot = end;
+    while (dot > name && dot[-1] != '.') dot--;
+    if (dot == name || dot == end) return 0;
+    char *stop;
+    *pid = strtol(dot, &stop, 10);
+    if (stop != end || *pid <= 0) return 0;
+    size_t hl = strlen(host);
+    const char *h = dot - 1 - hl;
+    return h > name && h[-1] == '.' && strncmp(h, host, hl) == 0;
+}
+
+int cal_atomic_sweep(const char *dir)
+{
+    char host[64];
+    this_host(host);
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    int removed = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        long pid;
+        if (!temporary_of_this_host(e->d_name, host, &pid)) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue; // its writer may still be alive
+        char path[2048];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        removed += unlink(path) == 0;
+    }
+    closedir(d);
+    return removed;
+}

@@ -11,6 +11,10 @@
 /// writable; 0 on success, else a message.
 int cal_mkdirs(const char *path, char *err, size_t err_len);
 
+/// The temporary name a file is written under before it is renamed to @p path:
+/// PATH.HOST.PID.tmp, so cal_atomic_sweep can tell a dead writer's leftovers.
+void cal_temporary_name(const char *path, char *tmp, size_t len);
+
 /// A file written under a temporary name and renamed into place on commit,
 /// so a killed run never leaves a half-written file under the final name.
 typedef struct cal_atomic_file {
@@ -21,6 +25,12 @@ typedef struct cal_atomic_file {
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len);
 int cal_atomic_commit(cal_atomic_file *a, char *err, size_t err_len);
 void cal_atomic_abort(cal_atomic_file *a);
+
+/// Remove the temporaries in @p dir left by writers on this host that died
+/// before committing (a SIGKILL between open and rename). Temporaries of live
+/// processes, and of other hosts sharing the folder, are left alone.
+/// Returns how many were removed.
+int cal_atomic_sweep(const char *dir);
 
 
 #endif

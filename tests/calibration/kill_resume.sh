@@ -35,5 +35,5 @@ echo "resume: ${before} of ${total} records were stored before it; it ran ${ran}
 # Stored records were not rewritten by the resume.
 changed=$(find "$work/killed/store" -name '*.yaml' ! -newer "$stamp" | wc -l)
 [ "$changed" -ge "$before" ] || { echo "stored records were rewritten"; exit 1; }
-ls "$work/killed/store" | grep -q '\.tmp$' && { echo "a temporary file was left behind"; exit 1; } || true
+[ -n "$(find "$work/killed" -name '*.tmp')" ] && { echo "a temporary file was left behind: $(find "$work/killed" -name '*.tmp')"; exit 1; } || true
 echo "same table after 5 kills; nothing stored was recomputed"

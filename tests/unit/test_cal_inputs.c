@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -16,6 +17,7 @@
 #include "cal_config.h"
 #include "cal_data.h"
 #include "cal_store.h"
+#include "cal_util.h"
 
 static char source[1024];
 
@@ -202,6 +204,34 @@ static void test_store_round_trip_and_collision_check(void **state)
     rmdir(dir);
 }
 
+static int file_exists(const char *path) { return access(path, F_OK) == 0; }
+
+// A run killed between writing a temporary and renaming it leaves the
+// temporary; the next run removes it, but never one a live writer or another
+// host (a rank on another machine, sharing the folder) may still be writing.
+static void test_sweep_removes_only_dead_writers_temporaries(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/granucal_sweep_XXXXXX", host[64] = "host", dead[1200], live[1200], foreign[1200],
+         record[1200];
+    assert_non_null(mkdtemp(dir));
+    gethostname(host, sizeof host - 1);
+    pid_t child = fork();
+    if (child == 0) _exit(0);
+    assert_int_equal(waitpid(child, NULL, 0), child); // reaped: its pid names no process now
+    snprintf(dead, sizeof dead, "%s/a.yaml.%s.%ld.tmp", dir, host, (long)child);
+    snprintf(live, sizeof live, "%s/b.yaml.%s.%ld.tmp", dir, host, (long)getpid());
+    snprintf(foreign, sizeof foreign, "%s/c.yaml.%s-elsewhere.%ld.tmp", dir, host, (long)child);
+    snprintf(record, sizeof record, "%s/d.yaml", dir);
+    const char *all[] = {dead, live, foreign, record};
+    for (int i = 0; i < 4; i++) write_file(all[i], "x\n");
+    assert_int_equal(cal_atomic_sweep(dir), 1);
+    assert_false(file_exists(dead));
+    assert_true(file_exists(live) && file_exists(foreign) && file_exists(record));
+    for (int i = 1; i < 4; i++) unlink(all[i]);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const char *s = getenv("GRANUCAL_SOURCE_DIR");
@@ -213,6 +243,7 @@ int main(void)
         cmocka_unit_test(test_shipped_config_loads),
         cmocka_unit_test(test_bad_config_named_by_line_and_field),
         cmocka_unit_test(test_store_round_trip_and_collision_check),
+        cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
