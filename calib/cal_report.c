@@ -207,8 +207,8 @@ static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_res
     for (int i = 0; i < r->n; ++i) {
         const cal_candidate *k = &r->cand[i];
         cal_drum_case dc = r->material[0]
-                               ? cal_drum_case_make(o->config, o->tier, r->k_n, r->frozen_mu_s, r->frozen_mu_r, k->mu_s, k->mu_r)
-                               : cal_drum_case_make(o->config, o->tier, r->k_n, k->mu_s, k->mu_r, k->mu_s, k->mu_r);
+                               ? cal_drum_case_wall(o->config, o->tier, r->k_n, r->frozen_mu_s, r->frozen_mu_r, k->mu_s, k->mu_r)
+                               : cal_drum_case_granule(o->config, o->tier, r->k_n, k->mu_s, k->mu_r);
         double rpm[CAL_MAX_RPM + 1];
         int n = r->n_rpm;
         memcpy(rpm, r->rpm, sizeof(double) * (size_t)n);
@@ -221,10 +221,10 @@ static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_res
             cal_store_hash(key, hash);
             cal_record rec;
             if (cal_store_get(store, key, &rec, err, sizeof err) != 0) continue;
-            fprintf(f, "%s,%d,%s,drum,%.6g,%.6g,%g,%s,\"%s\",%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.1f,%.4g,%d,%.6g\n", stage,
-                    i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
+            fprintf(f, "%s,%d,%s,drum,%.6g,%.6g,%g,%s,\"%s\",%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.1f,%.1f,%.4g,%d,%.6g,%.1f\n",
+                    stage, i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
                     rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s,
-                    rec.wall_time_s, rec.particle_steps, rec.granules, rec.dt_s);
+                    rec.wall_time_s, rec.fill_wall_time_s, rec.particle_steps, rec.granules, rec.dt_s, rec.peak_rss_mb);
             cal_record_free(&rec);
         }
     }
@@ -237,7 +237,8 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     fputs("stage,candidate,record,experiment,mu_s,mu_r,rpm_or_k_n,status,reason,angle_deg,angle_sd_deg,csa_percent,"
-          "csa_sd_percent,steady,simulated_time_s,wall_time_s,particle_steps,granules,dt_s_or_coordination\n",
+          "csa_sd_percent,steady,simulated_time_s,wall_time_s,fill_wall_time_s,particle_steps,granules,"
+          "dt_s_or_coordination,peak_rss_mb\n",
           a.f);
     const cal_stiffness_result *s = o->stiffness;
     for (int i = 0; s && i < s->n; ++i)
@@ -248,9 +249,9 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
             cal_store_hash(key, hash);
             cal_record rec;
             if (cal_store_get(store, key, &rec, e2, sizeof e2) != 0) continue;
-            fprintf(a.f, "stiffness,%d,%s,cylinder,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,,%d,%.5f\n", i + 1, hash,
-                    cd.granule.mu_s, cd.granule.mu_r, s->k[i], rec.status, rec.reason ? rec.reason : "",
-                    rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination);
+            fprintf(a.f, "stiffness,%d,%s,cylinder,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,0,,%d,%.5f,%.1f\n", i + 1,
+                    hash, cd.granule.mu_s, cd.granule.mu_r, s->k[i], rec.status, rec.reason ? rec.reason : "",
+                    rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination, rec.peak_rss_mb);
             cal_record_free(&rec);
         }
     if (o->granule) simulations_of(a.f, o, o->granule, store);

@@ -12,8 +12,8 @@
 #include "cal_util.h"
 #include "exp_common.h"
 
-cal_drum_case cal_drum_case_make(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
-                                 double wall_mu_s, double wall_mu_r)
+static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+                               double wall_mu_s, double wall_mu_r)
 {
     cal_drum_case d;
     d.def = exp_default_drum_def();
@@ -32,6 +32,20 @@ cal_drum_case cal_drum_case_make(const cal_config *c, const cal_tier *t, double 
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
     if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
     if (t->steady_csa_tol_percent > 0) d.run.csa_tol_percent = t->steady_csa_tol_percent;
+    d.fill = d.def;
+    return d;
+}
+
+cal_drum_case cal_drum_case_granule(const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r)
+{
+    return drum_case(c, t, k_n, mu_s, mu_r, mu_s, mu_r);
+}
+
+cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+                                 double wall_mu_s, double wall_mu_r)
+{
+    cal_drum_case d = drum_case(c, t, k_n, gg_mu_s, gg_mu_r, wall_mu_s, wall_mu_r);
+    d.fill = drum_case(c, t, k_n, gg_mu_s, gg_mu_r, gg_mu_s, gg_mu_r).def;
     return d;
 }
 
@@ -55,20 +69,34 @@ static void contact_text(char *out, size_t len, const dem_contact_params *p)
              p->mu_s, p->mu_r, (int)p->damping);
 }
 
-void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
+static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
 {
-    const exp_drum_def *d = &c->def;
-    const exp_drum_run_opts *r = &c->run;
     char gg[160], wall[160], plate[160];
     contact_text(gg, sizeof gg, &d->granule), contact_text(wall, sizeof wall, &d->wall);
     contact_text(plate, sizeof plate, &d->end_plate);
     snprintf(out, len,
              "drum v=%s D=%.10g depth=%.10g periodic=%d fill=%.10g lambda=%.10g rho=%.10g gsd=%.10g,%.10g,%.10g "
-             "granule[%s] wall[%s] plate[%s] pixel=%.10g closing=%d seed=%llu rpm=%.10g max_time=%.10g "
-             "sample=%.10g window=%.10g tol=%.10g,%.10g network_dt=%d",
+             "granule[%s] wall[%s] plate[%s] pixel=%.10g closing=%d seed=%llu",
              exp_version(), d->diameter, d->depth, d->periodic, d->fill, d->lambda, d->density, d->gsd.median_diameter,
              d->gsd.geometric_sd, d->gsd.truncation_sigmas, gg, wall, d->periodic ? "none" : plate, d->pixel,
-             d->closing_px, (unsigned long long)d->seed, rpm, r->max_time, r->sample_interval, r->window,
+             d->closing_px, (unsigned long long)d->seed);
+}
+
+void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
+{
+    const exp_drum_run_opts *r = &c->run;
+    char def[1024], turn_wall[160], fill_wall[160], turn_plate[160], fill_plate[160];
+    drum_def_text(&c->def, def, sizeof def);
+    // Only the fill's wall pair may differ from the turn's (cal_drum_case_wall).
+    contact_text(turn_wall, sizeof turn_wall, &c->def.wall), contact_text(fill_wall, sizeof fill_wall, &c->fill.wall);
+    contact_text(turn_plate, sizeof turn_plate, &c->def.end_plate);
+    contact_text(fill_plate, sizeof fill_plate, &c->fill.end_plate);
+    if (strcmp(turn_wall, fill_wall) == 0) snprintf(fill_wall, sizeof fill_wall, "same");
+    if (strcmp(turn_plate, fill_plate) == 0) snprintf(fill_plate, sizeof fill_plate, "same");
+    snprintf(out, len,
+             "%s filled_with_wall[%s] filled_with_plate[%s] rpm=%.10g max_time=%.10g sample=%.10g window=%.10g "
+             "tol=%.10g,%.10g network_dt=%d",
+             def, fill_wall, c->def.periodic ? "none" : fill_plate, rpm, r->max_time, r->sample_interval, r->window,
              r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt);
 }
 
@@ -143,7 +171,9 @@ static int turn_one(int i, void *ctx)
     r.angle_deg = res.angle_deg, r.angle_sd_deg = res.angle_sd_deg;
     r.csa_percent = res.csa_percent, r.csa_sd_percent = res.csa_sd_percent;
     r.steady = res.steady, r.simulated_time_s = res.simulated_time_s;
-    r.wall_time_s = exp_wall_seconds() - t0 + b->bed_wall_s; // the bed's cost is shared by every speed
+    r.wall_time_s = exp_wall_seconds() - t0;
+    r.fill_wall_time_s = i == 0 ? b->bed_wall_s : 0; // a bed settled now is charged once, to its first speed
+    r.peak_rss_mb = exp_peak_rss_mb();
     r.dt_s = dem_world_dt(w), r.particle_steps = (double)res.particle_steps, r.granules = (int)res.granules;
     char err[512];
     int bad = cal_store_put(b->env->store, &r, err, sizeof err);
@@ -179,19 +209,47 @@ static void turned(int i, int code, void *ctx)
     finish_task(b->env, b->keys[k], what, code);
 }
 
-// Fill this rank's bed and turn it at each of its missing speeds.
+// The last settled bed and what defined it: the wall stage's candidates all
+// turn the same one (cal_drum_case_wall), so it is settled once per process.
+static struct {
+    char text[1024];
+    dem_world *bed;
+} kept;
+
+void cal_sim_release(void)
+{
+    dem_world_destroy(kept.bed);
+    kept.bed = NULL;
+    kept.text[0] = 0;
+}
+
+// The settled bed of this fill definition: the kept one, or a new one (whose
+// wall time is then charged to the speeds turned now). NULL and a message
+// when the fill failed.
+static dem_world *settled_bed(const exp_drum_def *fill, double *wall_s, char *err, size_t len)
+{
+    char text[1024];
+    drum_def_text(fill, text, sizeof text);
+    *wall_s = 0;
+    if (kept.bed && strcmp(text, kept.text) == 0) return kept.bed;
+    cal_sim_release();
+    double t0 = exp_wall_seconds();
+    kept.bed = exp_drum_fill(fill, NULL, NULL, err, len);
+    *wall_s = exp_wall_seconds() - t0;
+    if (kept.bed) snprintf(kept.text, sizeof kept.text, "%s", text);
+    return kept.bed;
+}
+
+// Settle (or reuse) this rank's bed and turn it at each of its missing speeds.
 static void run_missing_drum(drum_batch *b, int n_todo)
 {
-    double t0 = exp_wall_seconds();
     char err[1024];
-    b->bed = exp_drum_fill(&b->c->def, NULL, NULL, err, sizeof err);
-    b->bed_wall_s = exp_wall_seconds() - t0;
+    b->bed = settled_bed(&b->c->fill, &b->bed_wall_s, err, sizeof err);
     if (!b->bed) {
         for (int i = 0; i < n_todo; ++i) write_failed(b->env, b->keys[b->todo[i]], err);
         return;
     }
     cal_pool_run(n_todo, turn_one, turned, b, b->env->workers, b->env->use_fork);
-    dem_world_destroy(b->bed);
 }
 
 int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
@@ -241,6 +299,7 @@ static int pour_one(int i, void *ctx)
     r.coordination = res.coordination, r.coordination_interior = res.coordination_interior;
     r.wall_contacts_per_granule = res.wall_contacts_per_granule, r.solid_fraction = res.solid_fraction;
     r.steady = 1, r.simulated_time_s = res.simulated_time_s, r.wall_time_s = exp_wall_seconds() - t0;
+    r.peak_rss_mb = exp_peak_rss_mb();
     r.dt_s = dem_world_dt(w), r.granules = (int)res.granules;
     dem_world_destroy(w);
     int bad = cal_store_put(b->env->store, &r, err, sizeof err);

@@ -25,16 +25,29 @@ typedef struct cal_env {
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
 } cal_env;
 
-/// A drum candidate: the drum and powder, and how each speed is run.
+/// A drum candidate: the drum and powder, how its bed is settled, and how
+/// each speed is run.
 typedef struct cal_drum_case {
-    exp_drum_def def;
+    exp_drum_def def;  ///< turned with these pairs
+    exp_drum_def fill; ///< settled with these (the same drum; only the wall pair may differ)
     exp_drum_run_opts run;
 } cal_drum_case;
 
-/// The drum of the config at its tier, with granule stiffness k_n and the
-/// given friction pairs (granule–granule; granule–wall lining).
-cal_drum_case cal_drum_case_make(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+/// Stage 2: the drum lined with granules (wall pair = granule pair) at
+/// granule stiffness k_n, settled and turned with that pair. The bed's
+/// packing, hence its CSA, depends on the granule pair, so each candidate
+/// settles its own bed (same seed: the same granules at the same places).
+cal_drum_case cal_drum_case_granule(const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r);
+
+/// Stage 3: the granule pair frozen, a wall material's pair (wall_mu_s,
+/// wall_mu_r). Every candidate turns the same bed, settled in the drum lined
+/// with granules: the wall changes only the boundary layer of a poured bed, so
+/// one fill serves the whole stage (a fill costs about as much as a turn).
+cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
                                  double wall_mu_s, double wall_mu_r);
+
+/// Free the settled bed kept between candidates (at the end of a run).
+void cal_sim_release(void);
 
 /// The poured cylinder of stage 1 at stiffness k_n and seed.
 exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);

@@ -87,8 +87,8 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     for (int i = 0; i < r->n; ++i) // a point seen before (COBYLA revisits): no new simulation
         if (r->cand[i].mu_s == mu_s && r->cand[i].mu_r == mu_r) return &r->cand[i];
     if (r->n >= CAL_MAX_EVALS || s->failed) return NULL;
-    cal_drum_case dc = s->material ? cal_drum_case_make(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
-                                   : cal_drum_case_make(s->c, s->t, r->k_n, mu_s, mu_r, mu_s, mu_r);
+    cal_drum_case dc = s->material ? cal_drum_case_wall(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
+                                   : cal_drum_case_granule(s->c, s->t, r->k_n, mu_s, mu_r);
     cal_record rec[CAL_MAX_RPM];
     double t0 = exp_wall_seconds();
     show_start(s, mu_s, mu_r);
@@ -100,7 +100,8 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     memset(k, 0, sizeof *k);
     k->mu_s = mu_s, k->mu_r = mu_r, k->from_grid = from_grid;
     score(s, k, rec);
-    for (int i = 0; i < s->n_sim; ++i) k->wall_time_s += rec[i].wall_time_s, cal_record_free(&rec[i]);
+    for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
+        k->wall_time_s += rec[i].wall_time_s + rec[i].fill_wall_time_s, cal_record_free(&rec[i]);
     double elapsed = exp_wall_seconds() - t0;
     fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g (%.0f s)\n",
             s->env->tty ? "\r\033[K" : "", s->env->stage, r->n, mu_s, mu_r, k->angle_deg, r->angle_target,

@@ -25,6 +25,7 @@ static const cyaml_schema_field_t record_fields[] = {
     REC_FLOAT("wall_contacts_per_granule", wall_contacts_per_granule), REC_FLOAT("solid_fraction", solid_fraction),
     CYAML_FIELD_BOOL("steady", CYAML_FLAG_OPTIONAL, cal_record, steady), REC_FLOAT("simulated_time_s", simulated_time_s),
     REC_FLOAT("wall_time_s", wall_time_s), REC_FLOAT("dt_s", dt_s), REC_FLOAT("particle_steps", particle_steps),
+    REC_FLOAT("fill_wall_time_s", fill_wall_time_s), REC_FLOAT("peak_rss_mb", peak_rss_mb),
     CYAML_FIELD_INT("granules", CYAML_FLAG_OPTIONAL, cal_record, granules), CYAML_FIELD_END};
 static const cyaml_schema_value_t record_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_record, record_fields)};
 
@@ -85,10 +86,11 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
             "angle_deg: %.17g\nangle_sd_deg: %.17g\ncsa_percent: %.17g\ncsa_sd_percent: %.17g\n"
             "coordination: %.17g\ncoordination_interior: %.17g\nwall_contacts_per_granule: %.17g\n"
             "solid_fraction: %.17g\nsteady: %s\nsimulated_time_s: %.17g\nwall_time_s: %.6g\ndt_s: %.17g\n"
-            "particle_steps: %.17g\ngranules: %d\n",
+            "particle_steps: %.17g\nfill_wall_time_s: %.6g\npeak_rss_mb: %.6g\ngranules: %d\n",
             r->angle_deg, r->angle_sd_deg, r->csa_percent, r->csa_sd_percent, r->coordination,
             r->coordination_interior, r->wall_contacts_per_granule, r->solid_fraction, r->steady ? "true" : "false",
-            r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->granules);
+            r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->fill_wall_time_s, r->peak_rss_mb,
+            r->granules);
     return cal_atomic_commit(&a, err, len);
 }
 

@@ -20,6 +20,8 @@ typedef struct cal_record {
     double coordination, coordination_interior, wall_contacts_per_granule, solid_fraction;
     int steady;
     double simulated_time_s, wall_time_s, dt_s, particle_steps;
+    double fill_wall_time_s; ///< settling the bed, charged to the first speed turned from it (else 0)
+    double peak_rss_mb;      ///< peak resident memory of the process that ran it
     int granules;
 } cal_record;
 

@@ -19,6 +19,9 @@ int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(
 /// Seconds of wall-clock time (monotonic) since an arbitrary origin.
 double exp_wall_seconds(void);
 
+/// Peak resident memory of this process so far, MiB (getrusage).
+double exp_peak_rss_mb(void);
+
 /// Create a directory and its parents (like mkdir -p); 0, or 1 with a message.
 int exp_mkdirs(const char *path, char *err, size_t len);
 

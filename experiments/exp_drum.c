@@ -240,6 +240,13 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
                            void *ctx, exp_drum_result *out)
 {
     memset(out, 0, sizeof *out);
+    // The turn's own friction: a bed may have been settled with another pair
+    // (a calibration's wall stage settles one bed for all its candidates).
+    dem_contact_params granule = dem_scale_contact(&d->granule, d->lambda), wall = dem_scale_contact(&d->wall, d->lambda),
+                       plate = dem_scale_contact(&d->end_plate, d->lambda);
+    int bad = dem_world_set_granule_contact(w, &granule) || dem_world_set_wall_contact(w, 0, &wall);
+    for (int k = 1; k < (d->periodic ? 1 : 3) && !bad; ++k) bad = dem_world_set_wall_contact(w, k, &plate);
+    if (bad) return DEM_ERR_INVALID;
     dem_status st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
     if (st != DEM_OK) return st;
     // The end plates are part of the drum and turn with it (walls 1 and 2

@@ -84,7 +84,9 @@ typedef struct exp_drum_result {
 } exp_drum_result;
 
 /// Turn a filled drum at opts->rpm until statistically steady (two
-/// consecutive windows agree) or max_time; the world is changed. Returns
+/// consecutive windows agree) or max_time; the world is changed. The contact
+/// pairs of @p d are applied first, so a bed settled with other friction
+/// turns with these. Returns
 /// the engine status; a fault is recorded in the result as not steady.
 dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
                            void *ctx, exp_drum_result *out);
