@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cyaml/cyaml.h>
@@ -144,27 +143,6 @@ static int check_surface(const cal_series *angles, const cal_series *areas, cons
     return 0;
 }
 
-static int check_output(const char *dir, char *err, size_t len)
-{
-    char probe[1200];
-    if (cal_mkdirs(dir, err, len)) return 1;
-    snprintf(probe, sizeof probe, "%s/store", dir);
-    if (cal_mkdirs(probe, err, len)) return 1;
-    cal_atomic_sweep(probe); // what a killed earlier run was writing when it died
-    cal_atomic_sweep(dir);
-    snprintf(probe, sizeof probe, "%s/.write_test.%ld", dir, (long)getpid());
-    FILE *f = fopen(probe, "w");
-    if (!f || fputs("x", f) < 0 || fclose(f) != 0)
-        return exp_fail(err, len, "%s: results folder is not writable: %s", dir, strerror(errno));
-    unlink(probe);
-    struct statvfs fs;
-    const double need = 50e6; // a calibration's records, tables and plots: a few MB; keep margin
-    if (statvfs(dir, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < need)
-        return exp_fail(err, len, "%s: only %.1f MB free; a calibration needs about %.0f MB", dir,
-                        (double)fs.f_bavail * (double)fs.f_frsize / 1e6, need / 1e6);
-    return 0;
-}
-
 typedef struct run {
     options opt;
     cal_config *c;
@@ -204,7 +182,7 @@ static int prepare(run *r)
         stem[strcspn(stem, ".")] = '\0';
         snprintf(r->out, sizeof r->out, "results/%.900s-%.60s", stem, r->t->name);
     }
-    return check_output(r->out, r->err, sizeof r->err);
+    return cal_prepare_output(r->out, r->err, sizeof r->err);
 }
 
 static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }

@@ -41,6 +41,25 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
+#define RUNG_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_rung, member)
+static const cyaml_schema_field_t rung_fields[] = {
+    CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_rung, name, 1, 31),
+    RUNG_FLOAT("lambda", lambda, CYAML_FLAG_DEFAULT),
+    RUNG_FLOAT("slice_depth", slice_depth, CYAML_FLAG_DEFAULT),
+    RUNG_FLOAT("max_time", max_time, CYAML_FLAG_DEFAULT),
+    RUNG_FLOAT("window", window, CYAML_FLAG_DEFAULT),
+    RUNG_FLOAT("sample_interval", sample_interval, CYAML_FLAG_OPTIONAL),
+    RUNG_FLOAT("steady_angle_tol_deg", steady_angle_tol_deg, CYAML_FLAG_OPTIONAL),
+    RUNG_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_END};
+static const cyaml_schema_value_t rung_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_rung, rung_fields)};
+
+static const cyaml_schema_field_t fidelity_fields[] = {
+    CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_POINTER, cal_fidelity, rpm, &float_entry, 1, 16),
+    CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_fidelity, seeds),
+    CYAML_FIELD_FLOAT("budget_hours", CYAML_FLAG_DEFAULT, cal_fidelity, budget_hours),
+    CYAML_FIELD_SEQUENCE("rungs", CYAML_FLAG_POINTER, cal_fidelity, rungs, &rung_entry, 1, 32), CYAML_FIELD_END};
+
 static const cyaml_schema_field_t bounds_fields[] = {
     CYAML_FIELD_FLOAT("mu_s_min", CYAML_FLAG_DEFAULT, cal_bounds, mu_s_min),
     CYAML_FIELD_FLOAT("mu_s_max", CYAML_FLAG_DEFAULT, cal_bounds, mu_s_max),
@@ -76,6 +95,7 @@ static const cyaml_schema_field_t config_fields[] = {
     CFG_STRING("tier", tier, CYAML_FLAG_DEFAULT, 31),
     CYAML_FIELD_SEQUENCE("tiers", CYAML_FLAG_POINTER, cal_config, tiers, &tier_entry, 1, 16),
     CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, cal_config, seed),
+    CYAML_FIELD_MAPPING_PTR("fidelity", CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, cal_config, fidelity, fidelity_fields),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t config_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_config, config_fields)};
 
@@ -113,29 +133,38 @@ static int check_bounds(const cal_config *c, const cal_bounds *b, const char *na
     return 0;
 }
 
-static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
+// The line of the `name: NAME` entry, to locate a tier's or a rung's errors.
+static int block_of(const cal_config *c, const char *name)
 {
-    char anchor[64];
-    snprintf(anchor, sizeof anchor, "%s", t->name);
-    int from = 1;
-    // The tier's own block starts at its `name:` line.
     for (int line = exp_yaml_line_of(c->path, "name", 1); line > 0; line = exp_yaml_line_of(c->path, "name", line + 1)) {
         FILE *f = fopen(c->path, "r");
         char text[512] = "";
         for (int k = 0; f && k < line && fgets(text, sizeof text, f); ++k) {}
         if (f) fclose(f);
-        if (strstr(text, anchor)) { from = line; break; }
+        if (strstr(text, name)) return line;
     }
-    struct { const char *field; double v; } positive[] = {
-        {"lambda", t->lambda}, {"max_time", t->max_time}, {"window", t->window}, {"cylinder_lambda", t->cylinder_lambda}};
-    for (size_t k = 0; k < sizeof positive / sizeof *positive; ++k)
-        if (bad_positive(positive[k].v) || (k != 1 && k != 2 && positive[k].v < 1))
-            return located(c, from, positive[k].field, err, len, "%g must be %s", positive[k].v,
-                           (k == 1 || k == 2) ? "> 0" : ">= 1");
-    if (!(t->slice_depth >= 0)) return located(c, from, "slice_depth", err, len, "%g must be >= 0 (0: full drum)", t->slice_depth);
-    if (!(2 * t->window <= t->max_time))
-        return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * t->window,
-                       t->max_time);
+    return 1;
+}
+
+// The knobs a tier and a rung share.
+static int check_drum_knobs(const cal_config *c, int from, double lambda, double slice_depth, double max_time,
+                            double window, char *err, size_t len)
+{
+    if (!(isfinite(lambda) && lambda >= 1)) return located(c, from, "lambda", err, len, "%g must be >= 1", lambda);
+    if (bad_positive(max_time)) return located(c, from, "max_time", err, len, "%g must be > 0", max_time);
+    if (bad_positive(window)) return located(c, from, "window", err, len, "%g must be > 0", window);
+    if (!(slice_depth >= 0)) return located(c, from, "slice_depth", err, len, "%g must be >= 0 (0: full drum)", slice_depth);
+    if (!(2 * window <= max_time))
+        return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * window, max_time);
+    return 0;
+}
+
+static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
+{
+    int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
+    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, err, len)) return 1;
+    if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
+        return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
     if (t->seeds < 1 || t->seeds > 64) return located(c, from, "seeds", err, len, "%d must be in [1, 64]", t->seeds);
     if (t->grid < 0 || t->grid > 16) return located(c, from, "grid", err, len, "%d must be in [0, 16]", t->grid);
     if (t->max_evaluations < 0 || t->max_evaluations > 1000)
@@ -148,6 +177,27 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "angle_sd_deg", err, len, "%g must be in [0, 45)", t->angle_sd_deg);
     for (unsigned k = 0; k < t->rpm_count; ++k)
         if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
+    return 0;
+}
+
+static int check_fidelity(const cal_config *c, char *err, size_t len)
+{
+    const cal_fidelity *f = c->fidelity;
+    int from = exp_yaml_line_of(c->path, "fidelity", 1);
+    if (f->seeds < 1 || f->seeds > 16) return located(c, from, "fidelity.seeds", err, len, "%d must be in [1, 16]", f->seeds);
+    if (bad_positive(f->budget_hours))
+        return located(c, from, "fidelity.budget_hours", err, len, "%g must be > 0", f->budget_hours);
+    for (unsigned k = 0; k < f->rpm_count; ++k)
+        if (!(f->rpm[k] > 0 && f->rpm[k] <= 1000))
+            return located(c, from, "fidelity.rpm", err, len, "%g must be in (0, 1000]", f->rpm[k]);
+    for (unsigned k = 0; k < f->rungs_count; ++k) {
+        const cal_rung *r = &f->rungs[k];
+        for (unsigned j = 0; j < k; ++j)
+            if (strcmp(r->name, f->rungs[j].name) == 0)
+                return located(c, from, "fidelity.rungs", err, len, "rung '%s' is defined twice", r->name);
+        if (check_drum_knobs(c, block_of(c, r->name), r->lambda, r->slice_depth, r->max_time, r->window, err, len))
+            return 1;
+    }
     return 0;
 }
 
@@ -199,7 +249,7 @@ static int validate(const cal_config *c, char *err, size_t len)
         return 1;
     for (unsigned k = 0; k < c->tiers_count; ++k)
         if (check_tier(c, &c->tiers[k], err, len)) return 1;
-    return 0;
+    return c->fidelity ? check_fidelity(c, err, len) : 0;
 }
 
 cal_config *cal_config_load(const char *path, const char *tier_override, char *err, size_t len)

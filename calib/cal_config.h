@@ -40,6 +40,26 @@ typedef struct cal_tier {
     double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
 } cal_tier;
 
+/// A rung of the fidelity study: the drum's accuracy knobs only.
+typedef struct cal_rung {
+    char *name;
+    double lambda, slice_depth, max_time, window; ///< as in a tier
+    double sample_interval, steady_angle_tol_deg, steady_csa_tol_percent; ///< optional, as in a tier
+} cal_rung;
+
+/// The fidelity study (`granucal study fidelity`): the drum lined with
+/// granules (wall pair = granule pair: Table 3's aluminium drum, as in Table
+/// B.1) at the config's granule-granule pair, over a ladder of rungs, several
+/// seeds each.
+typedef struct cal_fidelity {
+    double *rpm;                 ///< speeds turned on each rung
+    unsigned rpm_count;
+    int seeds;                   ///< seeds per rung (the spread)
+    double budget_hours;         ///< a rung predicted to take longer is listed, not run
+    cal_rung *rungs;
+    unsigned rungs_count;
+} cal_fidelity;
+
 typedef struct cal_config {
     char *calibration;                 ///< "drum"
     char *repose_angle, *occupied_area; ///< lab data, relative to the config file
@@ -60,6 +80,7 @@ typedef struct cal_config {
     cal_tier *tiers;
     unsigned tiers_count;
     int seed;
+    cal_fidelity *fidelity;            ///< optional: the fidelity study
     // Derived on load:
     char dir[1024];                    ///< directory of the config file
     char path[1024];

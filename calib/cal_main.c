@@ -19,6 +19,8 @@ static const char main_help[] =
     "                        configs/scenes/verification_two_particles.yaml) or a\n"
     "                        drum experiment (configs/drum.yaml)\n"
     "  measure PHOTO.png     angle of repose and occupied area of a drum photograph\n"
+    "  study fidelity        what accuracy costs in time: the drum over a ladder of\n"
+    "                        scale factors, depths and run lengths, error vs wall time\n"
     "  --version             print the version\n"
     "\n"
     "Run `granucal COMMAND --help` for the options of a command.\n";
@@ -28,7 +30,8 @@ typedef struct command {
     int (*run)(int argc, char **argv);
 } command;
 
-static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}, {"calibrate", cal_cmd_calibrate}};
+static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}, {"calibrate", cal_cmd_calibrate},
+                                   {"study", cal_cmd_study}};
 
 int main(int argc, char **argv)
 {

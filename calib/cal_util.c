@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -34,6 +35,27 @@ void cal_temporary_name(const char *path, char *tmp, size_t len)
     char host[64];
     this_host(host);
     snprintf(tmp, len, "%s.%s.%ld.tmp", path, host, (long)getpid());
+}
+
+int cal_prepare_output(const char *dir, char *err, size_t len)
+{
+    char probe[1200];
+    if (cal_mkdirs(dir, err, len)) return 1;
+    snprintf(probe, sizeof probe, "%s/store", dir);
+    if (cal_mkdirs(probe, err, len)) return 1;
+    cal_atomic_sweep(probe); // what a killed earlier run was writing when it died
+    cal_atomic_sweep(dir);
+    snprintf(probe, sizeof probe, "%s/.write_test.%ld", dir, (long)getpid());
+    FILE *f = fopen(probe, "w");
+    if (!f || fputs("x", f) < 0 || fclose(f) != 0)
+        return exp_fail(err, len, "%s: results folder is not writable: %s", dir, strerror(errno));
+    unlink(probe);
+    struct statvfs fs;
+    const double need = 50e6; // a calibration's records, tables and plots: a few MB; keep margin
+    if (statvfs(dir, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < need)
+        return exp_fail(err, len, "%s: only %.1f MB free; a calibration needs about %.0f MB", dir,
+                        (double)fs.f_bavail * (double)fs.f_frsize / 1e6, need / 1e6);
+    return 0;
 }
 
 int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_len)

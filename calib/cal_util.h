@@ -11,6 +11,11 @@
 /// writable; 0 on success, else a message.
 int cal_mkdirs(const char *path, char *err, size_t err_len);
 
+/// Make a results folder DIR and DIR/store, check that files can be written in
+/// it and that 50 MB are free, and remove temporaries a killed run left there:
+/// a bad folder is an error before any work starts. 0, else 1 with a message.
+int cal_prepare_output(const char *dir, char *err, size_t len);
+
 /// The temporary name a file is written under before it is renamed to @p path:
 /// PATH.HOST.PID.tmp, so cal_atomic_sweep can tell a dead writer's leftovers.
 void cal_temporary_name(const char *path, char *tmp, size_t len);

@@ -1,0 +1,475 @@
+// SPDX-License-Identifier: MIT
+// `granucal study fidelity`: what accuracy costs in time. The drum at the
+// config's granule-granule pair over a ladder of fidelity rungs (scale factor,
+// slice or full drum, run length, steady-state window and tolerance), several
+// seeds each, every simulation through the result store (resumable); then the
+// error of each rung against the finest rung run, against its wall time.
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include "cal_commands.h"
+#include "cal_mpi.h"
+#include "cal_plot.h"
+#include "cal_sim.h"
+#include "cal_util.h"
+#include "exp_common.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static const char help[] =
+    "usage: granucal study fidelity [CONFIG.yaml] [options]\n"
+    "\n"
+    "Runs the drum lined with granules at the config's granule-granule pair (Table 3:\n"
+    "mu_s 0.8, mu_r 0.2, the same as the aluminium drum of the paper's Table B.1) on each\n"
+    "rung of the config's `fidelity:` ladder: coarse-graining factor lambda (eq. 15-18),\n"
+    "periodic slice or full drum, run length, steady-state window and tolerance. Each\n"
+    "rung runs `seeds` beds (different granules) at every speed of `fidelity.rpm`.\n"
+    "\n"
+    "For each rung it records the angle and CSA at each speed (mean and spread over\n"
+    "seeds), granules, particle-steps, wall time and peak memory, and reports the error\n"
+    "against the finest rung that was run (smallest lambda; then full drum; then the\n"
+    "longest run) beside the paper's Table B.1 (lambda 8, 27, 64).\n"
+    "\n"
+    "A rung whose predicted wall time exceeds the budget left is not run; its prediction\n"
+    "(scaled from the largest rung run: granules ~ depth / lambda, steps ~ lambda^(-1/6)\n"
+    "since eq. 16-17 keep the granule mass, so dt_crit ~ lambda^(1/6)) is listed instead.\n"
+    "\n"
+    "options:\n"
+    "  --out DIR            results folder (default results/fidelity)\n"
+    "  --budget-hours H     replaces fidelity.budget_hours\n"
+    "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
+    "  --jobs N             simulations side by side (default: cores)\n"
+    "  -h, --help           this text\n"
+    "\n"
+    "Outputs in DIR: fidelity.csv (rung x speed), fidelity_summary.csv (rung),\n"
+    "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png, store/.\n"
+    "Run it again with the same options: stored simulations are not rerun.\n";
+
+enum { MAX_RUNGS = 32, MAX_SPEEDS = 16, MAX_SEEDS = 16 };
+
+// The paper's Table B.1: aluminium drum, calibrated model, angle and CSA.
+static const struct {
+    double lambda, angle_deg, csa_percent;
+} table_b1[] = {{8, 33.4, 43.9}, {27, 33.9, 44.5}, {64, 34.6, 45.5}};
+
+typedef struct options {
+    const char *config, *out, *rungs;
+    double budget_hours;
+    int jobs;
+} options;
+
+typedef struct rung_result {
+    const cal_rung *rung;
+    int ran;                     ///< 1 measured, 0 skipped (predicted only)
+    double predicted_s;          ///< wall time predicted before running (NAN: no basis yet)
+    double depth;                ///< m, slice or full drum
+    double angle[MAX_SPEEDS], angle_sd[MAX_SPEEDS]; ///< mean and spread over seeds
+    double csa[MAX_SPEEDS], csa_sd[MAX_SPEEDS];
+    int steady[MAX_SPEEDS], usable[MAX_SPEEDS];    ///< runs steady / runs with a measurement
+    double granules, particle_steps, wall_s, peak_rss_mb, dt_s;
+    double angle_error, csa_error; ///< against the reference rung
+} rung_result;
+
+typedef struct study {
+    options opt;
+    cal_config *c;
+    cal_env env;
+    char out[1024];
+    rung_result res[MAX_RUNGS];
+    int n;
+    int reference;               ///< index of the finest rung run
+    char err[2048];
+} study;
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    static const struct option longs[] = {{"out", required_argument, 0, 'o'}, {"budget-hours", required_argument, 0, 'b'},
+                                          {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
+                                          {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+    *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
+                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
+    optind = 1;
+    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+        char *end = NULL;
+        switch (ch) {
+        case 'o': o->out = optarg; break;
+        case 'r': o->rungs = optarg; break;
+        case 'b':
+            o->budget_hours = strtod(optarg, &end);
+            if (*end || !(o->budget_hours > 0))
+                return fprintf(stderr, "granucal study: --budget-hours '%s': need a number > 0\n", optarg), 2;
+            break;
+        case 'j':
+            o->jobs = (int)strtol(optarg, &end, 10);
+            if (*end || o->jobs < 1) return fprintf(stderr, "granucal study: --jobs '%s': need an integer >= 1\n", optarg), 2;
+            break;
+        case 'h': fputs(help, stdout); return -1;
+        default: fputs(help, stderr); return 2;
+        }
+    }
+    if (optind < argc) o->config = argv[optind++];
+    if (optind < argc) return fprintf(stderr, "granucal study: unexpected argument '%s'\n", argv[optind]), 2;
+    if (o->jobs < 1) o->jobs = 1;
+    return 0;
+}
+
+static int wanted(const char *list, const char *name)
+{
+    if (!list) return 1;
+    size_t n = strlen(name);
+    for (const char *p = list; (p = strstr(p, name)); p += n)
+        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == 0)) return 1;
+    return 0;
+}
+
+/// The rung as a calibration tier (the drum case takes one).
+static cal_tier tier_of(const cal_rung *r)
+{
+    return (cal_tier){.name = r->name, .lambda = r->lambda, .slice_depth = r->slice_depth, .max_time = r->max_time,
+                      .window = r->window, .sample_interval = r->sample_interval,
+                      .steady_angle_tol_deg = r->steady_angle_tol_deg,
+                      .steady_csa_tol_percent = r->steady_csa_tol_percent};
+}
+
+static cal_drum_case case_of(const study *s, const cal_rung *r, int seed)
+{
+    cal_tier t = tier_of(r);
+    cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+    d.def.seed = d.fill.seed = (uint64_t)(s->c->seed + seed);
+    return d;
+}
+
+// 1 if every simulation of the rung is already in the store.
+static int all_stored(const study *s, const cal_rung *r)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    for (int seed = 0; seed < f->seeds; ++seed) {
+        cal_drum_case d = case_of(s, r, seed);
+        for (unsigned k = 0; k < f->rpm_count; ++k) {
+            char key[2048], path[1300];
+            cal_drum_key(&d, f->rpm[k], key, sizeof key);
+            cal_store_path(s->env.store, key, path, sizeof path);
+            if (access(path, F_OK) != 0) return 0;
+        }
+    }
+    return 1;
+}
+
+// Wall time of a rung scaled from a measured one: granules ~ depth/lambda
+// (same bed volume per depth, granule volume ~ lambda), steps per simulated
+// second ~ 1/dt ~ lambda^(-1/6) (eq. 14 with eq. 16-17: the coarse granule
+// keeps the mass, the stiffness falls as lambda^(-1/3)), simulated time ~
+// speeds x max_time plus the fill (about 3 s of settling whatever lambda).
+static double predict_wall(const rung_result *base, const cal_rung *r, double depth)
+{
+    const double fill_s = 3.0;
+    double n = base->granules * (base->rung->lambda / r->lambda) * (depth / base->depth);
+    double steps_per_s = pow(base->rung->lambda / r->lambda, 1.0 / 6.0);
+    double time = (fill_s + r->max_time) / (fill_s + base->rung->max_time);
+    return base->wall_s * (n / base->granules) * steps_per_s * time;
+}
+
+static void mean_sd(const double *x, int n, double *mean, double *sd)
+{
+    double m = 0, v = 0;
+    for (int i = 0; i < n; ++i) m += x[i];
+    m = n ? m / n : NAN;
+    for (int i = 0; i < n; ++i) v += (x[i] - m) * (x[i] - m);
+    *mean = m, *sd = n > 1 ? sqrt(v / (n - 1)) : NAN;
+}
+
+// Run (or read back) every seed and speed of a rung and reduce them.
+static int measure_rung(study *s, rung_result *out)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    double angle[MAX_SPEEDS][MAX_SEEDS], csa[MAX_SPEEDS][MAX_SEEDS];
+    int n_ok[MAX_SPEEDS] = {0};
+    out->granules = out->particle_steps = out->wall_s = out->peak_rss_mb = 0;
+    for (int seed = 0; seed < f->seeds; ++seed) {
+        cal_drum_case d = case_of(s, out->rung, seed);
+        cal_record rec[MAX_SPEEDS];
+        if (cal_drum_evaluate(&s->env, &d, f->rpm, (int)f->rpm_count, rec, s->err, sizeof s->err)) return 1;
+        for (unsigned k = 0; k < f->rpm_count; ++k) {
+            const cal_record *r = &rec[k];
+            out->wall_s += r->wall_time_s + r->fill_wall_time_s;
+            out->particle_steps += r->particle_steps;
+            out->peak_rss_mb = fmax(out->peak_rss_mb, r->peak_rss_mb);
+            if (cal_record_usable(r) && isfinite(r->angle_deg)) {
+                angle[k][n_ok[k]] = r->angle_deg, csa[k][n_ok[k]] = r->csa_percent;
+                n_ok[k]++;
+                out->steady[k] += r->steady;
+                out->granules += r->granules, out->dt_s = r->dt_s;
+            }
+            cal_record_free(&rec[k]);
+        }
+    }
+    int usable = 0;
+    for (unsigned k = 0; k < f->rpm_count; ++k) {
+        out->usable[k] = n_ok[k], usable += n_ok[k];
+        mean_sd(angle[k], n_ok[k], &out->angle[k], &out->angle_sd[k]);
+        mean_sd(csa[k], n_ok[k], &out->csa[k], &out->csa_sd[k]);
+    }
+    out->granules = usable ? out->granules / usable : NAN;
+    out->ran = 1;
+    return 0;
+}
+
+// The finest rung run: the smallest lambda, then the full drum, then the
+// longest run and window.
+static int finer(const rung_result *a, const rung_result *b)
+{
+    if (a->rung->lambda != b->rung->lambda) return a->rung->lambda < b->rung->lambda;
+    if ((a->rung->slice_depth == 0) != (b->rung->slice_depth == 0)) return a->rung->slice_depth == 0;
+    if (a->rung->max_time != b->rung->max_time) return a->rung->max_time > b->rung->max_time;
+    return a->rung->window > b->rung->window;
+}
+
+static void errors_against_reference(study *s)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    s->reference = -1;
+    for (int i = 0; i < s->n; ++i)
+        if (s->res[i].ran && (s->reference < 0 || finer(&s->res[i], &s->res[s->reference]))) s->reference = i;
+    for (int i = 0; i < s->n; ++i) {
+        rung_result *r = &s->res[i];
+        r->angle_error = r->csa_error = NAN;
+        if (!r->ran || s->reference < 0) continue;
+        const rung_result *ref = &s->res[s->reference];
+        // The angle at the first speed (the lab's angle speed, 4 rpm in Table 2);
+        // the CSA as the root mean square over the speeds.
+        r->angle_error = fabs(r->angle[0] - ref->angle[0]);
+        double sum = 0;
+        int n = 0;
+        for (unsigned k = 0; k < f->rpm_count; ++k)
+            if (isfinite(r->csa[k]) && isfinite(ref->csa[k])) sum += pow(r->csa[k] - ref->csa[k], 2), n++;
+        r->csa_error = n ? sqrt(sum / n) : NAN;
+    }
+}
+
+static int write_csv(const study *s, char *err, size_t len)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    char path[1200];
+    cal_atomic_file a;
+    snprintf(path, sizeof path, "%s/fidelity.csv", s->out);
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,seeds,rpm,angle_deg,angle_sd_seeds_deg,csa_percent,"
+          "csa_sd_seeds_percent,steady_runs,usable_runs\n",
+          a.f);
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        for (unsigned k = 0; k < f->rpm_count; ++k)
+            fprintf(a.f, "%s,%g,%g,%g,%g,%d,%g,%.3f,%.3f,%.3f,%.3f,%d,%d\n", r->rung->name, r->rung->lambda,
+                    r->rung->slice_depth, r->rung->max_time, r->rung->window, f->seeds, f->rpm[k], r->angle[k],
+                    r->angle_sd[k], r->csa[k], r->csa_sd[k], r->steady[k], r->usable[k]);
+    }
+    if (cal_atomic_commit(&a, err, len)) return 1;
+    snprintf(path, sizeof path, "%s/fidelity_summary.csv", s->out);
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,status,granules,particle_steps,wall_time_s,"
+          "predicted_wall_time_s,peak_rss_mb,dt_s,angle_error_deg,csa_rms_error_percent,reference\n",
+          a.f);
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        fprintf(a.f, "%s,%g,%g,%g,%g,%s,%.0f,%.4g,%.1f,%.4g,%.1f,%.4g,%.3f,%.3f,%s\n", r->rung->name, r->rung->lambda,
+                r->rung->slice_depth, r->rung->max_time, r->rung->window, r->ran ? "run" : "not run (over budget)",
+                r->ran ? r->granules : NAN, r->ran ? r->particle_steps : NAN, r->ran ? r->wall_s : NAN, r->predicted_s,
+                r->ran ? r->peak_rss_mb : NAN, r->ran ? r->dt_s : NAN, r->angle_error, r->csa_error,
+                s->reference >= 0 ? s->res[s->reference].rung->name : "");
+    }
+    return cal_atomic_commit(&a, err, len);
+}
+
+static void machine_line(FILE *f)
+{
+    struct utsname u;
+    char model[256] = "unknown CPU", line[512];
+    FILE *cpu = fopen("/proc/cpuinfo", "r");
+    while (cpu && fgets(line, sizeof line, cpu))
+        if (strncmp(line, "model name", 10) == 0) {
+            const char *colon = strchr(line, ':');
+            snprintf(model, sizeof model, "%.200s", colon ? colon + 2 : line);
+            model[strcspn(model, "\n")] = 0;
+            break;
+        }
+    if (cpu) fclose(cpu);
+    uname(&u);
+    fprintf(f, "Machine: %s, %ld cores online, %s %s.  \n", model, sysconf(_SC_NPROCESSORS_ONLN), u.sysname, u.release);
+}
+
+// "mean ± sd", or the mean alone when one seed gives no spread.
+static void with_spread(char *out, size_t len, double mean, double sd)
+{
+    if (isfinite(sd)) snprintf(out, len, "%.2f ± %.2f", mean, sd);
+    else snprintf(out, len, "%.2f", mean);
+}
+
+static int write_markdown(const study *s, const char *command, double wall, char *err, size_t len)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    char path[1200];
+    cal_atomic_file a;
+    snprintf(path, sizeof path, "%s/fidelity.md", s->out);
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *o = a.f;
+    fprintf(o, "# What accuracy costs in time: the drum fidelity ladder\n\nCommand: `%s`  \ngranucal %s, config `%s`, "
+               "%.0f s wall for this run (stored simulations are not rerun).  \n",
+            command, exp_version(), s->c->path, wall);
+    machine_line(o);
+    fprintf(o, "Drum lined with granules, granule-granule pair μs = %g, μr = %g, k_n = %g N/m; %d seed(s) per rung; "
+               "speeds",
+            s->c->granule_mu_s, s->c->granule_mu_r, s->c->k_n, f->seeds);
+    for (unsigned k = 0; k < f->rpm_count; ++k) fprintf(o, " %g", f->rpm[k]);
+    fputs(" rpm. The angle is the first speed's; errors are against the reference rung (the finest run).\n\n", o);
+    fputs("| rung | λ | depth | run / window (s) | granules | angle (°) ± seeds | CSA (%) ± seeds | angle error (°) | "
+          "CSA rms error (%) | wall (s) | particle-steps | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+          o);
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        char depth[32];
+        if (r->rung->slice_depth > 0) snprintf(depth, sizeof depth, "%g mm slice", 1e3 * r->rung->slice_depth);
+        else snprintf(depth, sizeof depth, "full drum");
+        if (!r->ran) {
+            fprintf(o, "| %s | %g | %s | %g / %g | not run | | | | | predicted %.3g h | | |\n", r->rung->name,
+                    r->rung->lambda, depth, r->rung->max_time, r->rung->window, r->predicted_s / 3600);
+            continue;
+        }
+        char angle[48], csa[48];
+        with_spread(angle, sizeof angle, r->angle[0], r->angle_sd[0]);
+        with_spread(csa, sizeof csa, r->csa[0], r->csa_sd[0]);
+        fprintf(o, "| %s%s | %g | %s | %g / %g | %.0f | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n", r->rung->name,
+                i == s->reference ? " (reference)" : "", r->rung->lambda, depth, r->rung->max_time, r->rung->window,
+                r->granules, angle, csa, r->angle_error, r->csa_error, r->wall_s, r->particle_steps, r->peak_rss_mb);
+    }
+    fputs("\nThe paper's Table B.1 (aluminium drum, calibrated model; its rpm is not stated), beside the rungs:\n\n"
+          "| λ | angle (°) | CSA (%) |\n|---|---|---|\n",
+          o);
+    for (size_t k = 0; k < sizeof table_b1 / sizeof *table_b1; ++k)
+        fprintf(o, "| %g (paper) | %.1f | %.1f |\n", table_b1[k].lambda, table_b1[k].angle_deg, table_b1[k].csa_percent);
+    for (int i = 0; i < s->n; ++i)
+        if (s->res[i].ran)
+            fprintf(o, "| %g (%s, %g rpm) | %.2f | %.2f |\n", s->res[i].rung->lambda, s->res[i].rung->name, f->rpm[0],
+                    s->res[i].angle[0], s->res[i].csa[0]);
+    fputs("\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
+          "`fidelity_vs_lambda.png`.\n",
+          o);
+    return cal_atomic_commit(&a, err, len);
+}
+
+static int write_plots(const study *s, char *err, size_t len)
+{
+    double cost[MAX_RUNGS], ae[MAX_RUNGS], ce[MAX_RUNGS], lam[MAX_RUNGS], ang[MAX_RUNGS], ang_sd[MAX_RUNGS];
+    double csa[MAX_RUNGS], csa_sd[MAX_RUNGS];
+    int n = 0, m = 0;
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        lam[m] = r->rung->lambda, ang[m] = r->angle[0], ang_sd[m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
+        csa[m] = r->csa[0], csa_sd[m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0, m++;
+        if (i == s->reference) continue; // its error is zero by definition
+        cost[n] = r->wall_s, ae[n] = r->angle_error, ce[n] = r->csa_error, n++;
+    }
+    char path[1200];
+    cal_chart c = {.title = "Error against the finest rung vs wall time", .xlabel = "wall time of the rung (s)",
+                   .ylabel = "error (° for the angle, % for the CSA)", .log_x = 1, .hline = NAN};
+    c.series[c.n_series++] = (cal_series_xy){"angle error (°)", cost, ae, NULL, n, 0, 1, 0.8, 0.2, 0.1};
+    c.series[c.n_series++] = (cal_series_xy){"CSA rms error (%)", cost, ce, NULL, n, 0, 1, 0.1, 0.3, 0.8};
+    snprintf(path, sizeof path, "%s/fidelity_error_vs_cost.png", s->out);
+    if (n > 0 && cal_plot_chart(path, &c, err, len)) return 1;
+    double b1_l[3], b1_a[3], b1_c[3];
+    for (int k = 0; k < 3; ++k) b1_l[k] = table_b1[k].lambda, b1_a[k] = table_b1[k].angle_deg, b1_c[k] = table_b1[k].csa_percent;
+    cal_chart v = {.title = "Angle and CSA against the scale factor (first speed)", .xlabel = "scale factor λ",
+                   .ylabel = "angle (°) / CSA (%)", .log_x = 1, .hline = NAN};
+    v.series[v.n_series++] = (cal_series_xy){"angle, granucal (± seeds)", lam, ang, ang_sd, m, 0, 1, 0.8, 0.2, 0.1};
+    v.series[v.n_series++] = (cal_series_xy){"CSA, granucal (± seeds)", lam, csa, csa_sd, m, 0, 1, 0.1, 0.3, 0.8};
+    v.series[v.n_series++] = (cal_series_xy){"angle, Table B.1", b1_l, b1_a, NULL, 3, 1, 1, 0.9, 0.6, 0.5};
+    v.series[v.n_series++] = (cal_series_xy){"CSA, Table B.1", b1_l, b1_c, NULL, 3, 1, 1, 0.5, 0.6, 0.9};
+    snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->out);
+    return m > 0 && cal_plot_chart(path, &v, err, len);
+}
+
+// Run each wanted rung that fits the budget, in config order.
+static int run_ladder(study *s)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
+    for (unsigned k = 0; k < f->rungs_count && s->n < MAX_RUNGS; ++k) {
+        const cal_rung *rung = &f->rungs[k];
+        if (!wanted(s->opt.rungs, rung->name)) continue;
+        rung_result *r = &s->res[s->n++];
+        memset(r, 0, sizeof *r);
+        r->rung = rung, r->depth = rung->slice_depth > 0 ? rung->slice_depth : s->c->depth;
+        r->predicted_s = NAN;
+        const rung_result *base = NULL; // the largest rung measured so far
+        for (int i = 0; i < s->n - 1; ++i)
+            if (s->res[i].ran && (!base || s->res[i].particle_steps > base->particle_steps)) base = &s->res[i];
+        if (base) r->predicted_s = predict_wall(base, rung, r->depth);
+        if (base && r->predicted_s > budget_s - spent && !all_stored(s, rung)) {
+            fprintf(stderr, "[fidelity] %s: not run, predicted %.3g h > %.3g h of budget left\n", rung->name,
+                    r->predicted_s / 3600, (budget_s - spent) / 3600);
+            continue;
+        }
+        s->env.stage = rung->name;
+        cal_sim_release(); // each rung settles its own beds: its cost includes them
+        fprintf(stderr, "[fidelity] %s: lambda %g, %s, %g s per speed, %d seed(s)%s\n", rung->name, rung->lambda,
+                rung->slice_depth > 0 ? "periodic slice" : "full drum", rung->max_time, f->seeds,
+                base ? "" : " (no prediction: first rung)");
+        if (measure_rung(s, r)) return 1;
+        spent += r->wall_s;
+    }
+    return 0;
+}
+
+int cal_cmd_study(int argc, char **argv)
+{
+    if (argc < 2 || strcmp(argv[1], "fidelity") != 0) {
+        if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) return fputs(help, stdout), 0;
+        fprintf(stderr, "granucal study: the study to run is `fidelity`\n\n%s", help);
+        return 2;
+    }
+    study *s = calloc(1, sizeof *s);
+    if (!s) return fputs("granucal study: out of memory\n", stderr), 1;
+    int status = parse_options(argc - 1, argv + 1, &s->opt);
+    if (status) return free(s), status < 0 ? 0 : status;
+    char command[2048] = "granucal";
+    for (int k = 0; k < argc; ++k) snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
+    cal_mpi_init(&argc, &argv);
+#ifdef _OPENMP
+    omp_set_num_threads(1); // parallel across simulations, one thread each (as calibrate)
+#endif
+    double t0 = exp_wall_seconds();
+    s->c = cal_config_load(s->opt.config, NULL, s->err, sizeof s->err);
+    if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
+    else if (!s->c) status = 1;
+    if (!status) {
+        snprintf(s->out, sizeof s->out, "%s", s->opt.out);
+        status = cal_prepare_output(s->out, s->err, sizeof s->err);
+    }
+    if (!status) {
+        snprintf(s->env.store, sizeof s->env.store, "%s/store", s->out);
+        s->env.workers = s->opt.jobs, s->env.use_fork = cal_mpi_size() == 1, s->env.tty = isatty(2);
+        s->env.started = t0;
+        status = run_ladder(s);
+    }
+    if (!status && cal_mpi_rank() == 0) {
+        errors_against_reference(s);
+        status = write_csv(s, s->err, sizeof s->err) || write_markdown(s, command, exp_wall_seconds() - t0, s->err, sizeof s->err) ||
+                 write_plots(s, s->err, sizeof s->err);
+        if (!status) fprintf(stderr, "granucal study: wrote %s/fidelity.md and its CSV and plots\n", s->out);
+    }
+    if (status) fprintf(stderr, "granucal study: %s\n", s->err);
+    status = cal_mpi_any(status);
+    cal_sim_release();
+    if (s->c) cal_config_free(s->c);
+    free(s);
+    cal_mpi_finalize();
+    return status ? 1 : 0;
+}
