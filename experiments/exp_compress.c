@@ -31,6 +31,7 @@
 #define SETTLE_KE_RATIO (1e-6 * FILL_GRAVITY)
 #define SETTLE_MAX_TIME 0.1
 #define RELAX_MAX_TIME 0.02
+#define CHECK_EVERY 0.002 // s between rest checks: a layer lands in milliseconds under FILL_GRAVITY
 #define APPROACH_FACTOR 10.0
 #define WALL_SIDE 0
 #define WALL_FLOOR 1
@@ -121,50 +122,6 @@ static dem_world *create_die(const exp_compress_def *d, double gravity, char *er
 }
 
 static void move_piston(dem_world *w, double y) { w->walls[WALL_PISTON].def.point.y = y; }
-
-// exp_run_until_rest checks every 0.05 s, longer than a whole layer takes
-// to land under FILL_GRAVITY: the same test every 2 ms.
-static int run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
-                          const char *phase)
-{
-    uint64_t chunk = (uint64_t)(0.002 / dem_world_dt(w)) + 1; // exp_run_for steps 0.01 s at a time
-    for (double t0 = dem_world_time(w); dem_world_time(w) - t0 < max_time;) {
-        if (dem_world_step(w, chunk) != DEM_OK) return 1;
-        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
-        if (exp_ke_ratio(w, d50) < ratio) break;
-    }
-    return 0;
-}
-
-static int inside_die(dem_vec3 p, const void *ctx)
-{
-    double inner = *(const double *)ctx;
-    return p.x * p.x + p.z * p.z <= inner * inner;
-}
-
-// Pour in layers until the bed surface passes the rim; keep the granules
-// whose centres lie below it (the lab strikes the powder off at the rim).
-static int pour_to_rim(dem_world *w, const exp_compress_def *d, const dem_gsd *gsd, exp_progress_fn progress,
-                       void *ctx, char *err, size_t len)
-{
-    double r = 0.5 * d->diameter, pitch = 1.05 * dem_gsd_max_diameter(gsd), inner = r - 0.55 * pitch;
-    size_t cap = 3 * dem_gsd_count_for_volume(gsd, 0.6 * DEM_PI * r * r * d->depth) + 16, next = 0;
-    double *diam = malloc(cap * sizeof *diam);
-    if (!diam || dem_gsd_sample(gsd, d->seed, cap, diam)) return free(diam), exp_fail(err, len, "cannot sample sizes");
-    exp_pour_region region = {dem_v3(-inner, 0, -inner), dem_v3(inner, 2 * d->depth, inner), inside_die, &inner};
-    double rho = dem_scale_density(d->density, d->lambda);
-    while (exp_bed_surface(w, 0) < d->depth) {
-        size_t placed = next < cap ? exp_pour_layer(w, &region, 0, diam, next, cap, pitch, rho) : 0;
-        if (placed == 0) return free(diam), exp_fail(err, len, "compression: ran out of room or sizes while pouring");
-        if (dem_world_prepare(w) != DEM_OK ||
-            run_until_rest(w, gsd->median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
-            return free(diam), exp_fail(err, len, "%s", dem_world_error(w));
-        next += placed;
-    }
-    free(diam);
-    exp_remove_above(w, d->depth);
-    return 0;
-}
 
 // Spring forces on the piston, the floor and the side wall: the normal
 // springs k_n·h of eq. 3 (the dashpot is left out: at the quasi-static rate
@@ -327,8 +284,11 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
     // is negligible against σ_min (ρ_bulk·g·H ≈ 0.03 Pa at λ = 4096).
     dem_world *f = create_die(d, FILL_GRAVITY * 9.81, err, len);
     if (!f) return NULL;
-    if (pour_to_rim(f, d, &gsd, progress, ctx, err, len) ||
-        run_until_rest(f, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
+    exp_rim_pour pour = {"compression", 0.5 * d->diameter, d->depth, 2.0, &gsd, d->seed,
+                         dem_scale_density(d->density, d->lambda), LAYER_KE_RATIO, LAYER_MAX_TIME, CHECK_EVERY};
+    if (exp_pour_to_rim(f, &pour, progress, ctx, err, len) ||
+        exp_run_until_rest(f, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, CHECK_EVERY, progress, ctx,
+                           "settle")) {
         if (!err[0]) exp_fail(err, len, "%s", dem_world_error(f));
         dem_world_destroy(f);
         return NULL;
@@ -349,7 +309,7 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
     // the piston is lowered onto the bed first and the bed relaxes under it.
     move_piston(w, bed_top(w) + 0.02 * dem_gsd_max_diameter(&gsd));
     if (dem_world_prepare(w) != DEM_OK ||
-        run_until_rest(w, gsd.median_diameter, 1e-6, RELAX_MAX_TIME, progress, ctx, "relax")) {
+        exp_run_until_rest(w, gsd.median_diameter, 1e-6, RELAX_MAX_TIME, CHECK_EVERY, progress, ctx, "relax")) {
         exp_fail(err, len, "%s", dem_world_error(w));
         dem_world_destroy(w);
         return NULL;

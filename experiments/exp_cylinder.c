@@ -12,6 +12,7 @@
 #define LAYER_MAX_TIME 0.6
 #define SETTLE_KE_RATIO 1e-6
 #define SETTLE_MAX_TIME 2.0
+#define CHECK_EVERY 0.05 // s between rest checks
 
 exp_cylinder_def exp_default_cylinder_def(void)
 {
@@ -52,37 +53,6 @@ static dem_world *create_container(const exp_cylinder_def *d, char *err, size_t 
     return w;
 }
 
-static int inside_column(dem_vec3 p, const void *ctx)
-{
-    double inner = *(const double *)ctx;
-    return p.x * p.x + p.z * p.z <= inner * inner;
-}
-
-// Pour until the bed surface passes the rim; then keep the granules whose
-// centres lie below it.
-static int pour_to_rim(dem_world *w, const exp_cylinder_def *d, const dem_gsd *gsd, exp_progress_fn progress,
-                       void *ctx, char *err, size_t len)
-{
-    double r = 0.5 * d->diameter, pitch = 1.05 * dem_gsd_max_diameter(gsd), inner = r - 0.55 * pitch;
-    double volume = DEM_PI * r * r * d->depth;
-    size_t cap = 3 * dem_gsd_count_for_volume(gsd, 0.6 * volume) + 16, next = 0;
-    double *diam = malloc(cap * sizeof *diam);
-    if (!diam || dem_gsd_sample(gsd, d->seed, cap, diam)) return free(diam), exp_fail(err, len, "cannot sample sizes");
-    exp_pour_region region = {dem_v3(-inner, 0, -inner), dem_v3(inner, 3 * d->depth, inner), inside_column, &inner};
-    double rho = dem_scale_density(d->density, d->lambda);
-    while (exp_bed_surface(w, 0) < d->depth) {
-        size_t placed = next < cap ? exp_pour_layer(w, &region, 0, diam, next, cap, pitch, rho) : 0;
-        if (placed == 0) return free(diam), exp_fail(err, len, "poured cylinder: ran out of room or sizes");
-        if (dem_world_prepare(w) != DEM_OK ||
-            exp_run_until_rest(w, gsd->median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
-            return free(diam), exp_fail(err, len, "%s", dem_world_error(w));
-        next += placed;
-    }
-    free(diam);
-    exp_remove_above(w, d->depth);
-    return 0;
-}
-
 // Interior coordination number and solid fraction of the bed at rest.
 static void count_contacts(const dem_world *w, const exp_cylinder_def *d, double dmax, exp_cylinder_result *out)
 {
@@ -118,8 +88,11 @@ dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress,
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     dem_world *w = create_container(d, err, len);
     if (!w) return NULL;
-    if (pour_to_rim(w, d, &gsd, progress, ctx, err, len) ||
-        exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle")) {
+    exp_rim_pour pour = {"poured cylinder", 0.5 * d->diameter, d->depth, 3.0, &gsd, d->seed,
+                         dem_scale_density(d->density, d->lambda), LAYER_KE_RATIO, LAYER_MAX_TIME, CHECK_EVERY};
+    if (exp_pour_to_rim(w, &pour, progress, ctx, err, len) ||
+        exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, CHECK_EVERY, progress, ctx,
+                           "settle")) {
         if (!err[0]) exp_fail(err, len, "%s", dem_world_error(w));
         dem_world_destroy(w);
         return NULL;

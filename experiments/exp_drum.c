@@ -13,6 +13,7 @@
 #define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE over (bed mass)·g·d50
 #define SETTLE_MAX_TIME 2.0    // s
 #define SETTLE_KE_RATIO 1e-4   // KE over (bed mass)·g·d50 at rest (see exp_drum_fill)
+#define CHECK_EVERY 0.05       // s between rest checks
 
 exp_drum_def exp_default_drum_def(void)
 {
@@ -171,7 +172,7 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
         size_t placed = next < cap ? place_layer(w, d, diam, next, cap, pitch) : 0;
         if (placed == 0) return fill_failed(w, diam, err, len, "no room left to pour: the fill degree is too high");
         if (dem_world_prepare(w) != DEM_OK ||
-            exp_run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, progress, ctx, "pour"))
+            exp_run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, CHECK_EVERY, progress, ctx, "pour"))
             return fill_failed(w, diam, err, len, NULL);
         next += placed;
     }
@@ -183,7 +184,8 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     // 6.4 mm of lambda 32768, 35x above SETTLE_KE_RATIO. A stricter 1e-6 was
     // never reached by a granule-lined bed (mu_r 0.2 creeps) before
     // SETTLE_MAX_TIME, and cost 80% of the fill: 2.0 s against 0.3 s now.
-    if (exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, progress, ctx, "settle"))
+    if (exp_run_until_rest(w, gsd.median_diameter, SETTLE_KE_RATIO, SETTLE_MAX_TIME, CHECK_EVERY, progress, ctx,
+                           "settle"))
         return fill_failed(w, NULL, err, len, NULL);
     return w;
 }

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "exp_pour.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+
+#include "dem_vec.h"
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -61,17 +64,6 @@ static int keep_below(const dem_granules_view *g, size_t i, void *ctx) { return 
 
 void exp_remove_above(dem_world *w, double y) { dem_world_remove_granules(w, keep_below, &y); }
 
-int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
-{
-    uint64_t chunk = (uint64_t)(0.01 / dem_world_dt(w)) + 1;
-    double t_end = dem_world_time(w) + seconds;
-    while (dem_world_time(w) < t_end) {
-        if (dem_world_step(w, chunk) != DEM_OK) return 1;
-        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
-    }
-    return 0;
-}
-
 double exp_ke_ratio(const dem_world *w, double d50)
 {
     dem_granules_view g = dem_world_granules(w);
@@ -81,12 +73,51 @@ double exp_ke_ratio(const dem_world *w, double d50)
     return g.count ? (d.ke_translational + d.ke_rotational) / (mass * 9.81 * d50) : 0.0;
 }
 
-int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
-                       const char *phase)
+int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)
 {
-    for (double t = 0; t < max_time; t += 0.05) {
-        if (exp_run_for(w, 0.05, progress, ctx, phase)) return 1;
+    uint64_t chunk = (uint64_t)(fmin(0.01, seconds) / dem_world_dt(w)) + 1;
+    double t_end = dem_world_time(w) + seconds;
+    while (dem_world_time(w) < t_end) {
+        if (dem_world_step(w, chunk) != DEM_OK) return 1;
+        if (progress) progress(phase, dem_world_time(w), dem_world_granules(w).count, ctx);
+    }
+    return 0;
+}
+
+int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, double check_every,
+                       exp_progress_fn progress, void *ctx, const char *phase)
+{
+    for (double t = 0; t < max_time; t += check_every) {
+        if (exp_run_for(w, check_every, progress, ctx, phase)) return 1;
         if (exp_ke_ratio(w, d50) < ratio) break;
     }
+    return 0;
+}
+
+static int inside_cylinder(dem_vec3 p, const void *ctx)
+{
+    double inner = *(const double *)ctx;
+    return p.x * p.x + p.z * p.z <= inner * inner;
+}
+
+int exp_pour_to_rim(dem_world *w, const exp_rim_pour *p, exp_progress_fn progress, void *ctx, char *err, size_t len)
+{
+    double pitch = 1.05 * dem_gsd_max_diameter(p->gsd), inner = p->radius - 0.55 * pitch;
+    size_t cap = 3 * dem_gsd_count_for_volume(p->gsd, 0.6 * DEM_PI * p->radius * p->radius * p->depth) + 16, next = 0;
+    double *diam = malloc(cap * sizeof *diam);
+    if (!diam || dem_gsd_sample(p->gsd, p->seed, cap, diam))
+        return free(diam), exp_fail(err, len, "%s: cannot sample sizes", p->what);
+    exp_pour_region region = {dem_v3(-inner, 0, -inner), dem_v3(inner, p->headroom * p->depth, inner), inside_cylinder,
+                              &inner};
+    while (exp_bed_surface(w, 0) < p->depth) {
+        size_t placed = next < cap ? exp_pour_layer(w, &region, 0, diam, next, cap, pitch, p->density) : 0;
+        if (placed == 0) return free(diam), exp_fail(err, len, "%s: ran out of room or sizes while pouring", p->what);
+        if (dem_world_prepare(w) != DEM_OK || exp_run_until_rest(w, p->gsd->median_diameter, p->layer_ke_ratio,
+                                                                 p->layer_max_time, p->check_every, progress, ctx, "pour"))
+            return free(diam), exp_fail(err, len, "%s", dem_world_error(w));
+        next += placed;
+    }
+    free(diam);
+    exp_remove_above(w, p->depth);
     return 0;
 }

@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 
+#include "dem_gsd.h"
 #include "dem_world.h"
 #include "exp_common.h"
 
@@ -39,9 +40,27 @@ double exp_ke_ratio(const dem_world *w, double d50);
 /// Run `seconds`, reporting progress every 0.01 s; non-zero on a fault.
 int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase);
 
-/// Run in 0.05 s chunks until exp_ke_ratio < ratio or max_time; non-zero on
-/// an engine fault.
-int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, exp_progress_fn progress, void *ctx,
-                       const char *phase);
+/// Run until exp_ke_ratio < ratio, checked every `check_every` s, or
+/// max_time; non-zero on an engine fault. A pour under a stronger gravity
+/// lands a layer in milliseconds and checks more often than a drum's 0.05 s.
+int exp_run_until_rest(dem_world *w, double d50, double ratio, double max_time, double check_every,
+                       exp_progress_fn progress, void *ctx, const char *phase);
+
+/// Pouring into an upright cylindrical container (axis y, floor y = 0) up to
+/// its rim, as the lab fills the compression die and the poured cylinder.
+typedef struct exp_rim_pour {
+    const char *what;          ///< the experiment, for messages
+    double radius, depth;      ///< container; the rim is at y = depth
+    double headroom;           ///< the lattice reaches headroom × depth
+    const dem_gsd *gsd;        ///< scaled GSD
+    unsigned long long seed;
+    double density;            ///< scaled density
+    double layer_ke_ratio, layer_max_time, check_every; ///< when a layer has landed
+} exp_rim_pour;
+
+/// Pour layers until the bed surface passes the rim, then keep the granules
+/// whose centres lie below it (the lab strikes the powder off at the rim).
+/// 0, else 1 with a message.
+int exp_pour_to_rim(dem_world *w, const exp_rim_pour *p, exp_progress_fn progress, void *ctx, char *err, size_t len);
 
 #endif
