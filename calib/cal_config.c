@@ -146,23 +146,30 @@ static int block_of(const cal_config *c, const char *name)
     return 1;
 }
 
-// The knobs a tier and a rung share.
+// The knobs a tier and a rung share; `optional` holds sample_interval,
+// steady_angle_tol_deg and steady_csa_tol_percent (0 or absent: the drum's default).
 static int check_drum_knobs(const cal_config *c, int from, double lambda, double slice_depth, double max_time,
-                            double window, char *err, size_t len)
+                            double window, const double optional[3], char *err, size_t len)
 {
     if (!(isfinite(lambda) && lambda >= 1)) return located(c, from, "lambda", err, len, "%g must be >= 1", lambda);
     if (bad_positive(max_time)) return located(c, from, "max_time", err, len, "%g must be > 0", max_time);
     if (bad_positive(window)) return located(c, from, "window", err, len, "%g must be > 0", window);
-    if (!(slice_depth >= 0)) return located(c, from, "slice_depth", err, len, "%g must be >= 0 (0: full drum)", slice_depth);
+    if (!(isfinite(slice_depth) && slice_depth >= 0))
+        return located(c, from, "slice_depth", err, len, "%g must be >= 0 and finite (0: full drum)", slice_depth);
     if (!(2 * window <= max_time))
         return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * window, max_time);
+    static const char *const optional_names[3] = {"sample_interval", "steady_angle_tol_deg", "steady_csa_tol_percent"};
+    for (int k = 0; k < 3; ++k)
+        if (!(isfinite(optional[k]) && optional[k] >= 0))
+            return located(c, from, optional_names[k], err, len, "%g must be >= 0 and finite (0: the default)", optional[k]);
     return 0;
 }
 
 static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
-    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, err, len)) return 1;
+    const double optional[3] = {t->sample_interval, t->steady_angle_tol_deg, t->steady_csa_tol_percent};
+    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, err, len)) return 1;
     if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
     if (t->seeds < 1 || t->seeds > 64) return located(c, from, "seeds", err, len, "%d must be in [1, 64]", t->seeds);
@@ -195,7 +202,9 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
         for (unsigned j = 0; j < k; ++j)
             if (strcmp(r->name, f->rungs[j].name) == 0)
                 return located(c, from, "fidelity.rungs", err, len, "rung '%s' is defined twice", r->name);
-        if (check_drum_knobs(c, block_of(c, r->name), r->lambda, r->slice_depth, r->max_time, r->window, err, len))
+        const double optional[3] = {r->sample_interval, r->steady_angle_tol_deg, r->steady_csa_tol_percent};
+        if (check_drum_knobs(c, block_of(c, r->name), r->lambda, r->slice_depth, r->max_time, r->window, optional, err,
+                             len))
             return 1;
     }
     return 0;
@@ -237,7 +246,8 @@ static int validate(const cal_config *c, char *err, size_t len)
         return located(c, 1, "granule_mu_r", err, len, "%g must be in [0, 10]", c->granule_mu_r);
     if (!(c->pour_mu_s >= 0 && c->pour_mu_s <= 10)) return located(c, 1, "pour_mu_s", err, len, "%g must be in [0, 10]", c->pour_mu_s);
     if (!(c->pour_mu_r >= 0 && c->pour_mu_r <= 10)) return located(c, 1, "pour_mu_r", err, len, "%g must be in [0, 10]", c->pour_mu_r);
-    if (!(c->stiffness_tolerance >= 0)) return located(c, 1, "stiffness_tolerance", err, len, "%g must be >= 0", c->stiffness_tolerance);
+    if (!(isfinite(c->stiffness_tolerance) && c->stiffness_tolerance >= 0))
+        return located(c, 1, "stiffness_tolerance", err, len, "%g must be >= 0 and finite", c->stiffness_tolerance);
     for (unsigned k = 0; k < c->stiffness_count; ++k) {
         if (bad_positive(c->stiffness[k])) return located(c, 1, "stiffness", err, len, "%g must be > 0", c->stiffness[k]);
         if (k && !(c->stiffness[k] > c->stiffness[k - 1]))

@@ -4,6 +4,7 @@
 #include "cal_data.h"
 
 #include <csv.h>
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -86,6 +87,11 @@ static void add_point(reader *r)
 {
     cal_point p = {.line = r->line};
     if (!r->fields[0][0]) return (void)fail_at(r, "surface", "%s", "empty");
+    // A quoted field may span lines in CSV, not in this schema (and a '#'
+    // line inside it would have been dropped as a comment).
+    for (const char *c = r->fields[0]; *c; ++c)
+        if (iscntrl((unsigned char)*c))
+            return (void)fail_at(r, "surface", "%s", "holds a line break or a control character");
     snprintf(p.surface, sizeof p.surface, "%s", r->fields[0]);
     double hi = r->kind == CAL_DATA_ANGLE ? 90 : 100;
     if (parse_value(r, 1, 0, 1000, 1, &p.rpm) || parse_value(r, 2, 0, hi, 1, &p.value) ||
@@ -145,6 +151,12 @@ int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *e
     // quoted newline inside a field is not part of this schema.
     while (!r.failed && (n = getline(&line, &cap, f)) > 0) {
         r.line++;
+        // A NUL byte would end the line early for the C string checks (a line
+        // starting with one read as blank) and cut a field short for strtod.
+        if (memchr(line, '\0', (size_t)n)) {
+            fail_at(&r, "row", "%s", "contains a NUL byte: not a text file");
+            break;
+        }
         if (blank_or_comment(line)) continue;
         if (csv_parse(&p, line, (size_t)n, on_field, on_row, &r) != (size_t)n && !r.failed)
             fail_at(&r, "row", "malformed CSV (%s)", csv_strerror(csv_error(&p)));

@@ -156,14 +156,28 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
 static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t len)
 {
     if (strcmp(y->experiment, "drum") != 0) return located(path, "experiment", err, len, "must be drum");
+    // libcyaml reads inf and nan as numbers; the range checks below let inf through.
+    const struct { const char *key; double v; } numbers[] = {
+        {"diameter", y->diameter}, {"depth", y->depth}, {"fill", y->fill}, {"slice_depth", y->slice_depth},
+        {"density", y->density}, {"median_diameter", y->median_diameter}, {"geometric_sd", y->geometric_sd},
+        {"truncation_sigmas", y->truncation_sigmas}, {"lambda", y->lambda}, {"k_n", y->k_n}, {"xi", y->xi},
+        {"mu_s", y->mu_s}, {"mu_r", y->mu_r}, {"rpm", y->rpm}, {"max_time", y->max_time}, {"window", y->window},
+        {"sample_interval", y->sample_interval}, {"pixel", y->pixel}};
+    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
+        if (!isfinite(numbers[k].v))
+            return located(path, numbers[k].key, err, len, "%g must be a finite number", numbers[k].v);
+    if (y->window < 0) return located(path, "window", err, len, "%g must be >= 0 (0 or absent: 1 s)", y->window);
+    if (y->sample_interval < 0)
+        return located(path, "sample_interval", err, len, "%g must be >= 0 (0 or absent: 0.05 s)", y->sample_interval);
     if (!(y->rpm >= 0 && y->rpm <= 1000)) return located(path, "rpm", err, len, "%g must be in [0, 1000]", y->rpm);
     if (!(y->max_time > 0)) return located(path, "max_time", err, len, "%g must be > 0", y->max_time);
     if (y->periodic && !(y->slice_depth > 0))
         return located(path, "slice_depth", err, len, "%g must be > 0 for a periodic slice", y->slice_depth);
     if (!(y->k_n > 0)) return located(path, "k_n", err, len, "%g must be > 0", y->k_n);
     for (unsigned k = 0; k < y->materials_count; ++k)
-        if (!(y->materials[k].mu_s >= 0) || !(y->materials[k].mu_r >= 0))
-            return located(path, "materials", err, len, "'%s': friction must be >= 0", y->materials[k].name);
+        if (!(isfinite(y->materials[k].mu_s) && y->materials[k].mu_s >= 0) ||
+            !(isfinite(y->materials[k].mu_r) && y->materials[k].mu_r >= 0))
+            return located(path, "materials", err, len, "'%s': friction must be finite and >= 0", y->materials[k].name);
     exp_drum_def def;
     exp_drum_run_opts run;
     char msg[300];
@@ -182,6 +196,10 @@ exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, c
     cyaml_err_t e = cyaml_load_file(path, &quiet, &drum_schema, (cyaml_data_t **)&y, NULL);
     if (e != CYAML_OK) {
         exp_fail(err, len, "%s: %s (check the keys and value types against configs/drum.yaml)", path, cyaml_strerror(e));
+        return NULL;
+    }
+    if (!y) { // an empty document (no bytes, only comments) loads as CYAML_OK and NULL
+        exp_fail(err, len, "%s: no YAML document in the file (see configs/drum.yaml)", path);
         return NULL;
     }
     for (int k = 0; k < n_sets; ++k)

@@ -181,6 +181,10 @@ exp_scene *exp_scene_load(const char *path, char *err, size_t err_len)
         exp_fail(err, err_len, "%s: %s%s%s", path, cyaml_strerror(e), log.used ? ": " : "", log.text);
         return NULL;
     }
+    if (!s) { // an empty document (no bytes, only comments) loads as CYAML_OK and NULL
+        exp_fail(err, err_len, "%s: no YAML document in the file", path);
+        return NULL;
+    }
     if (validate(path, s, err, err_len)) {
         exp_scene_free(s);
         return NULL;

@@ -59,6 +59,11 @@ int exp_yaml_load(const char *path, const cyaml_schema_value_t *schema, void **o
     cyaml_config_t cfg = {.log_fn = capture, .log_ctx = &c, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
     *out = NULL;
     cyaml_err_t e = cyaml_load_file(path, &cfg, schema, (cyaml_data_t **)out, NULL);
+    // An empty document (no bytes, only comments) loads as CYAML_OK and NULL.
+    if (e == CYAML_OK && !*out) {
+        if (hint) return exp_fail(err, len, "%s: no YAML document in the file (%s)", path, hint);
+        return exp_fail(err, len, "%s: no YAML document in the file", path);
+    }
     if (e == CYAML_OK) return 0;
     const char *why = c.problem[0] ? c.problem : cyaml_strerror(e);
     // An unknown key is reported against its enclosing mapping; find the key's own line.

@@ -18,6 +18,8 @@
 #include "cal_data.h"
 #include "cal_store.h"
 #include "cal_util.h"
+#include "exp_drum_config.h"
+#include "exp_scene.h"
 
 static char source[1024];
 
@@ -167,6 +169,69 @@ static void test_bad_config_named_by_line_and_field(void **state)
                         "max_evaluations");                                 // in a tier's own block
 }
 
+// What fuzzing the loaders found (tests/fuzz): each was accepted, or crashed.
+static void write_bytes(const char *path, const char *bytes, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(bytes, 1, n, f), n);
+    fclose(f);
+}
+
+static void test_fuzz_findings_refused(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/granucal_fuzz_XXXXXX", err[1024], want[600];
+    close(mkstemp(path));
+    // CSV: a NUL byte cut a number short ("4\0junk" read as 4) or made a row blank.
+    static const char nul[] = "surface,rpm,csa_percent,csa_sd_percent\nPP,4\0junk,45,1\n";
+    write_bytes(path, nul, sizeof nul - 1);
+    cal_series s;
+    assert_int_equal(cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err), 1);
+    snprintf(want, sizeof want, "%s:2: row", path);
+    if (!strstr(err, want)) fail_msg("expected '%s' in: %s", want, err);
+    // CSV: a quoted surface spanning lines, with a comment line inside dropped.
+    write_file(path, "surface,rpm,csa_percent,csa_sd_percent\n\"PP\n# c\n\",4,45,1\n");
+    assert_int_equal(cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err), 1);
+    snprintf(want, sizeof want, "%s:4: surface", path);
+    if (!strstr(err, want)) fail_msg("expected '%s' in: %s", want, err);
+    // YAML: an empty file (or only comments) loaded as "OK, nothing": a NULL dereference.
+    const char *empty[] = {"", "# only a comment\n"};
+    for (int k = 0; k < 2; ++k) {
+        write_file(path, empty[k]);
+        err[0] = '\0';
+        assert_null(cal_config_load(path, NULL, err, sizeof err));
+        assert_non_null(strstr(err, path));
+        err[0] = '\0';
+        assert_null(exp_drum_config_load(path, 0, NULL, err, sizeof err));
+        assert_non_null(strstr(err, path));
+        err[0] = '\0';
+        assert_null(exp_scene_load(path, err, sizeof err));
+        assert_non_null(strstr(err, path));
+    }
+    unlink(path);
+    // Calibration config: inf passed the ">= 0" checks.
+    expect_config_error("stiffness_tolerance: 0 ", "stiffness_tolerance: inf ", "stiffness_tolerance");
+    expect_config_error("max_evaluations: 2\n", "max_evaluations: 2\n    sample_interval: inf\n", "sample_interval");
+    // Drum config: inf passed "max_time > 0" (and window, sample_interval, pixel, slice_depth).
+    char shipped[1200];
+    snprintf(shipped, sizeof shipped, "%s/configs/drum.yaml", source);
+    FILE *f = fopen(shipped, "r");
+    assert_non_null(f);
+    static char text[1 << 14], edited[1 << 14];
+    text[fread(text, 1, sizeof text - 1, f)] = '\0';
+    fclose(f);
+    const char *at = strstr(text, "max_time: 6.0");
+    assert_non_null(at);
+    snprintf(edited, sizeof edited, "%.*smax_time: inf%s", (int)(at - text), text, at + strlen("max_time: 6.0"));
+    close(mkstemp(path));
+    write_file(path, edited);
+    assert_null(exp_drum_config_load(path, 0, NULL, err, sizeof err));
+    snprintf(want, sizeof want, "%s:", path);
+    if (!strstr(err, want) || !strstr(err, "max_time")) fail_msg("expected '%s' and max_time in: %s", want, err);
+    unlink(path);
+}
+
 static void test_store_round_trip_and_collision_check(void **state)
 {
     (void)state;
@@ -242,6 +307,7 @@ int main(void)
         cmocka_unit_test(test_quoted_and_commented_csv_reads),
         cmocka_unit_test(test_shipped_config_loads),
         cmocka_unit_test(test_bad_config_named_by_line_and_field),
+        cmocka_unit_test(test_fuzz_findings_refused),
         cmocka_unit_test(test_store_round_trip_and_collision_check),
         cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
     };
