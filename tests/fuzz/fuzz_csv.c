@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+// libFuzzer target: the lab data loader (calib/cal_data.c, libcsv) on any
+// bytes, read as a repose-angle file and as an occupied-area file.
+// Invariant: cal_series_load either accepts the file, and then every point
+// is a valid measurement (what the loader promises its callers), or refuses
+// it with a non-empty message naming the file and leaves nothing allocated;
+// never a crash, a leak or undefined behaviour (ASan, UBSan). A file with a
+// NUL byte is not text: it must be refused.
+#include <math.h>
+#include <string.h>
+#include <strings.h>
+
+#include "cal_data.h"
+#include "fuzz_common.h"
+
+static void check_accepted(const cal_series *s, cal_data_kind kind, const char *path)
+{
+    char detail[256];
+    double hi = kind == CAL_DATA_ANGLE ? 90 : 100;
+    if (strcmp(s->path, path) != 0) fuzz_violation("cal_series_load: path not recorded", s->path);
+    if (s->count == 0 || !s->points) fuzz_violation("cal_series_load accepted a file without measurements", NULL);
+    for (size_t k = 0; k < s->count; ++k) {
+        const cal_point *p = &s->points[k];
+        snprintf(detail, sizeof detail, "point %zu (line %d): '%.64s' rpm %g value %g sd %g", k, p->line, p->surface,
+                 p->rpm, p->value, p->sd);
+        if (!memchr(p->surface, '\0', sizeof p->surface) || !p->surface[0])
+            fuzz_violation("accepted an empty or unterminated surface", detail);
+        for (const char *c = p->surface; *c; ++c)
+            if ((unsigned char)*c < 0x20 || *c == 0x7f) fuzz_violation("accepted a control character in a surface", detail);
+        if (!(isfinite(p->rpm) && p->rpm > 0 && p->rpm <= 1000)) fuzz_violation("accepted an rpm outside (0, 1000]", detail);
+        if (!(isfinite(p->value) && p->value > 0 && p->value <= hi)) fuzz_violation("accepted a value out of range", detail);
+        if (!(isfinite(p->sd) && p->sd >= 0 && p->sd <= hi)) fuzz_violation("accepted a spread out of range", detail);
+        // Non-decreasing, not increasing: libcsv also ends rows at a lone CR
+        // (old Mac files), which getline does not count as a line.
+        if (p->line < 1 || (k && p->line < s->points[k - 1].line)) fuzz_violation("line numbers out of order", detail);
+        for (size_t j = 0; j < k; ++j)
+            if (strcasecmp(s->points[j].surface, p->surface) == 0 && s->points[j].rpm == p->rpm)
+                fuzz_violation("accepted a duplicate (surface, rpm)", detail);
+    }
+}
+
+static void load(const char *path, cal_data_kind kind, int has_nul)
+{
+    char err[2048];
+    cal_series s;
+    memset(err, 0, sizeof err);
+    if (cal_series_load(&s, path, kind, err, sizeof err) == 0) {
+        if (has_nul) fuzz_violation("cal_series_load accepted a file with a NUL byte", NULL);
+        fuzz_report(kind == CAL_DATA_ANGLE ? "cal_series_load(angle)" : "cal_series_load(csa)", NULL);
+        check_accepted(&s, kind, path);
+        cal_series_free(&s);
+        if (s.points || s.count) fuzz_violation("cal_series_free left points behind", NULL);
+        return;
+    }
+    fuzz_check_failure_message(kind == CAL_DATA_ANGLE ? "cal_series_load(angle)" : "cal_series_load(csa)", path, err);
+    if (s.points || s.count) fuzz_violation("cal_series_load failed but kept points", err);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    const char *path = fuzz_write_temp(data, size);
+    int has_nul = size > 0 && memchr(data, '\0', size) != NULL;
+    load(path, CAL_DATA_ANGLE, has_nul);
+    load(path, CAL_DATA_CSA, has_nul);
+    return 0;
+}
