@@ -509,10 +509,26 @@ static dem_status fault(dem_world *w, dem_status code, size_t i, const char *wha
     return code;
 }
 
+// First granule whose position, velocity or spin is not finite, or SIZE_MAX.
+static size_t first_nonfinite(const dem_world *w)
+{
+    for (size_t i = 0; i < w->n; ++i)
+        if (!dem_v3_isfinite(w->pos[i]) || !dem_v3_isfinite(w->vel[i]) || !dem_v3_isfinite(w->omg[i])) return i;
+    return SIZE_MAX;
+}
+
 dem_status dem_world_step(dem_world *w, uint64_t steps)
 {
     dem_status st = dem_world_prepare(w);
     if (st != DEM_OK) return st;
+    // A state that is already not finite (put there through
+    // dem_world_set_granule_velocity, or left by an earlier fault) is reported
+    // against its own granule before anything is computed from it: the force
+    // evaluation would pass the NaN to its contact partners, and the first of
+    // those by index would be named; the drift would make its position NaN,
+    // which the domain test would report as an escape. One pass per call.
+    size_t bad0 = first_nonfinite(w);
+    if (bad0 != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad0, "non-finite state (NaN or infinity)");
     if (!w->forces_valid) {
         if (refresh_list(w)) return DEM_ERR_NOMEM;
         w->hist_dt = w->moved ? w->dt : 0.0; // re-evaluation at an unchanged configuration: springs stay
@@ -528,6 +544,9 @@ dem_status dem_world_step(dem_world *w, uint64_t steps)
         if (escaped) {
             w->forces_valid = 0;
             w->moved = 1;
+            // A position that overflowed to infinity or NaN did not leave the domain.
+            if (!dem_v3_isfinite(w->pos[bad]))
+                return fault(w, DEM_ERR_NONFINITE, bad, "non-finite state (NaN or infinity)");
             return fault(w, DEM_ERR_ESCAPED, bad, "granule left the domain");
         }
         if (refresh_list(w)) return DEM_ERR_NOMEM;
