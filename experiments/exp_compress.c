@@ -22,6 +22,7 @@
 #include "exp_plot.h"
 #include "exp_pour.h"
 #include "exp_scene.h"
+#include "exp_yaml.h"
 
 #define FILL_GRAVITY 30.0 // pour and settle under 30 g (see exp_compress_run)
 // exp_ke_ratio divides by (bed mass)·9.81·d50: the thresholds carry the
@@ -395,7 +396,6 @@ static const cyaml_schema_field_t compress_fields[] = {
 #undef F
 static const cyaml_schema_value_t compress_schema = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, compress_yaml, compress_fields)};
-static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
 
 int exp_is_compress_config(const char *path)
 {
@@ -462,12 +462,7 @@ static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
 static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
 {
     compress_yaml *y = NULL;
-    cyaml_err_t e = cyaml_load_file(path, &quiet, &compress_schema, (cyaml_data_t **)&y, NULL);
-    if (e != CYAML_OK) {
-        exp_fail(err, len, "%s: %s (check the keys and value types against configs/compression.yaml)", path,
-                 cyaml_strerror(e));
-        return NULL;
-    }
+    if (exp_yaml_load(path, &compress_schema, (void **)&y, "check the keys and value types against configs/compression.yaml", err, len)) return NULL;
     char msg[300];
     int bad = 0;
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
@@ -480,7 +475,7 @@ static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp
         bad = located(path, leaf ? leaf + 1 : field, err, len, msg);
     }
     if (bad) {
-        cyaml_free(&quiet, &compress_schema, y, 0);
+        exp_yaml_free(&compress_schema, y);
         return NULL;
     }
     return y;
@@ -490,7 +485,7 @@ int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_de
 {
     compress_yaml *y = load_config(path, n_sets, sets, d, err, len);
     if (!y) return 1;
-    cyaml_free(&quiet, &compress_schema, y, 0);
+    exp_yaml_free(&compress_schema, y);
     return 0;
 }
 
@@ -572,7 +567,7 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/compression");
     if (exp_mkdirs(dir, err, sizeof err)) {
         fprintf(stderr, "granucal simulate: %s\n", err);
-        cyaml_free(&quiet, &compress_schema, y, 0);
+        exp_yaml_free(&compress_schema, y);
         return 1;
     }
     progress_state p = {0, exp_wall_seconds()};
@@ -591,6 +586,6 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
     }
     exp_compress_result_free(&r);
     dem_world_destroy(w);
-    cyaml_free(&quiet, &compress_schema, y, 0);
+    exp_yaml_free(&compress_schema, y);
     return rc;
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Drum experiment config: libcyaml schema, overrides, validation.
 #include "exp_drum_config.h"
+#include "exp_yaml.h"
 
 #include <cyaml/cyaml.h>
 
@@ -40,7 +41,6 @@ static const cyaml_schema_field_t drum_fields[] = {
     CYAML_FIELD_INT("seed", CYAML_FLAG_OPTIONAL, exp_drum_yaml, seed), CYAML_FIELD_END};
 static const cyaml_schema_value_t drum_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, exp_drum_yaml, drum_fields)};
 
-static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
 
 int exp_is_drum_config(const char *path)
 {
@@ -193,15 +193,9 @@ static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t 
 exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, char *err, size_t len)
 {
     exp_drum_yaml *y = NULL;
-    cyaml_err_t e = cyaml_load_file(path, &quiet, &drum_schema, (cyaml_data_t **)&y, NULL);
-    if (e != CYAML_OK) {
-        exp_fail(err, len, "%s: %s (check the keys and value types against configs/drum.yaml)", path, cyaml_strerror(e));
+    if (exp_yaml_load(path, &drum_schema, (void **)&y, "check the keys and value types against configs/drum.yaml", err,
+                      len))
         return NULL;
-    }
-    if (!y) { // an empty document (no bytes, only comments) loads as CYAML_OK and NULL
-        exp_fail(err, len, "%s: no YAML document in the file (see configs/drum.yaml)", path);
-        return NULL;
-    }
     for (int k = 0; k < n_sets; ++k)
         if (apply_set(y, sets[k], err, len)) {
             exp_drum_config_free(y);
@@ -216,5 +210,5 @@ exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, c
 
 void exp_drum_config_free(exp_drum_yaml *y)
 {
-    if (y) cyaml_free(&quiet, &drum_schema, y, 0);
+    exp_yaml_free(&drum_schema, y);
 }

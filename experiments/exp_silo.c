@@ -13,6 +13,7 @@
 #include "dem_output.h"
 #include "exp_plot.h"
 #include "exp_scene.h"
+#include "exp_yaml.h"
 
 // Fixed spheres: this density makes a contact force move one by less than
 // 1e-12 m over the run; gravity is cancelled by the velocity reset.
@@ -370,7 +371,6 @@ static const cyaml_schema_field_t silo_fields[] = {
     CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, silo_yaml, seed), CYAML_FIELD_END};
 #undef F
 static const cyaml_schema_value_t silo_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, silo_yaml, silo_fields)};
-static const cyaml_config_t quiet = {.log_fn = NULL, .mem_fn = cyaml_mem, .log_level = CYAML_LOG_ERROR};
 
 int exp_is_silo_config(const char *path)
 {
@@ -428,11 +428,7 @@ static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
 static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len)
 {
     silo_yaml *y = NULL;
-    cyaml_err_t e = cyaml_load_file(path, &quiet, &silo_schema, (cyaml_data_t **)&y, NULL);
-    if (e != CYAML_OK) {
-        exp_fail(err, len, "%s: %s (check the keys and value types against configs/silo.yaml)", path, cyaml_strerror(e));
-        return NULL;
-    }
+    if (exp_yaml_load(path, &silo_schema, (void **)&y, "check the keys and value types against configs/silo.yaml", err, len)) return NULL;
     int bad = 0;
     char msg[300];
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
@@ -460,7 +456,7 @@ static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_sil
         }
     }
     if (bad) {
-        cyaml_free(&quiet, &silo_schema, y, 0);
+        exp_yaml_free(&silo_schema, y);
         return NULL;
     }
     return y;
@@ -509,7 +505,7 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     exp_silo_def d;
     silo_yaml *y = load_config(path, n_sets, sets, &d, err, sizeof err);
     if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    cyaml_free(&quiet, &silo_schema, y, 0);
+    exp_yaml_free(&silo_schema, y);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/silo");
     if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     progress_state ps = {0, exp_wall_seconds()};
