@@ -38,6 +38,7 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
     CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
     TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("angle_offset_deg", angle_offset_deg, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -182,6 +183,8 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "seeds", err, len, "one seed gives no spread: use seeds >= 2 or set stiffness_tolerance");
     if (!(t->angle_sd_deg >= 0 && t->angle_sd_deg < 45))
         return located(c, from, "angle_sd_deg", err, len, "%g must be in [0, 45)", t->angle_sd_deg);
+    if (!(fabs(t->angle_offset_deg) < 45))
+        return located(c, from, "angle_offset_deg", err, len, "%g must be in (-45, 45)", t->angle_offset_deg);
     for (unsigned k = 0; k < t->rpm_count; ++k)
         if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
     return 0;

@@ -38,6 +38,8 @@ typedef struct cal_tier {
     int grid;               ///< initial design: grid points per axis of (μs, log μr)
     int max_evaluations;    ///< NLopt evaluations after the grid
     double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
+    double angle_offset_deg; ///< the tier's angle bias against the paper's fidelity (measured): the lab angle
+                             ///< plus this is the target in the tier's own scale; 0 = none
 } cal_tier;
 
 /// A rung of the fidelity study: the drum's accuracy knobs only.

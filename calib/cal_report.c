@@ -329,9 +329,13 @@ static void report_friction(FILE *f, const cal_friction_result *r)
     const char *stage = r->material[0] ? r->material : "granule-granule";
     fprintf(f, "\n## %s (surface '%s' in the data)\n\n", stage, r->surface);
     if (r->material[0]) fprintf(f, "Granule–granule frozen at μs = %.4g, μr = %.4g. ", r->frozen_mu_s, r->frozen_mu_r);
-    fprintf(f, "Target angle %.2f° at %g rpm, tolerance ±%.2f° (lab spread and this tier's spread combined). "
-               "CSA at %d speeds. NLopt COBYLA: %s. %d candidates, %.0f s.\n\n",
-            r->angle_target, r->angle_rpm, r->angle_tolerance, r->n_rpm, r->nlopt_result, r->n, r->wall_time_s);
+    fprintf(f, "Target angle %.2f° at %g rpm", r->angle_target, r->angle_rpm);
+    if (r->angle_offset != 0)
+        fprintf(f, " (the lab's %.2f° plus this tier's measured offset %+.2f°: its coarse granules pile steeper)",
+                r->angle_lab, r->angle_offset);
+    fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. NLopt COBYLA: "
+               "%s. %d candidates, %.0f s.\n\n",
+            r->angle_tolerance, r->n_rpm, r->nlopt_result, r->n, r->wall_time_s);
     if (r->best >= 0) {
         const cal_candidate *b = &r->cand[r->best];
         fprintf(f, "**Chosen:** μs = %.4g, μr = %.4g: angle %.2f° ± %.2f, CSA misfit %.3g%s.\n\n", b->mu_s, b->mu_r,

@@ -181,7 +181,11 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     const cal_point *pts[64];
     size_t n = cal_series_select(angles, r->surface, pts, 64);
     if (n == 0) return exp_fail(s->err, s->len, "%s: no angle of repose for surface '%s'", angles->path, r->surface);
-    r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
+    // A coarse tier measures a biased angle (the angle grows with the scale
+    // factor, Table B.1); its measured offset moves the lab's target onto the
+    // tier's own scale (cal_tier.angle_offset_deg, README "Table 3 in CI").
+    r->angle_lab = pts[0]->value, r->angle_offset = s->t->angle_offset_deg;
+    r->angle_target = r->angle_lab + r->angle_offset, r->angle_rpm = pts[0]->rpm;
     r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + s->t->angle_sd_deg * s->t->angle_sd_deg);
     n = cal_series_select(areas, r->surface, pts, 64);
     if (n == 0) return exp_fail(s->err, s->len, "%s: no occupied area for surface '%s'", areas->path, r->surface);

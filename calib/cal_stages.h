@@ -48,7 +48,8 @@ typedef struct cal_friction_result {
     char surface[64];
     double k_n;
     double frozen_mu_s, frozen_mu_r;    ///< granule–granule pair (wall stage)
-    double angle_target, angle_tolerance, angle_rpm;
+    double angle_target, angle_tolerance, angle_rpm; ///< target in the tier's scale: lab + offset
+    double angle_lab, angle_offset;                  ///< the lab's angle and the tier's offset
     int n_rpm;
     double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
     int n;                              ///< candidates evaluated
