@@ -108,7 +108,13 @@ static void test_table3_reproduced(void **state)
                paper[i].parameter, paper[i].value, o->value, dev, t->log_scale ? "d" : " ", t->allowed,
                ok ? "ok" : "OUTSIDE");
     }
-    printf("(d: decades, log10 of calibrated/paper)\n\nTolerances:\n");
+    printf("(d: decades, log10 of calibrated/paper)\n\nWhere each calibrated value came from:\n");
+    fflush(stdout);
+    snprintf(cmd, sizeof cmd, "cat '%s/table3/calibrated_parameters.md'; grep -h 'Target angle\\|Chosen\\|Unresolved' "
+                              "'%s/table3/report.md'",
+             bin, bin);
+    if (system(cmd) != 0) printf("(could not show calibrated_parameters.md and report.md)\n");
+    printf("\nTolerances:\n");
     for (size_t k = 0; k < sizeof tolerances / sizeof *tolerances; ++k)
         printf("  %s %s %s: %g%s — %s\n", tolerances[k].contact, tolerances[k].material, tolerances[k].parameter,
                tolerances[k].allowed, tolerances[k].log_scale ? " decades" : "", tolerances[k].reason);
