@@ -1,10 +1,22 @@
 // SPDX-License-Identifier: MIT
 // Tolerances of the Table 3 comparison (test_table3.c), each with its reason.
 //
-// STATUS: the inputs and rules below are final; the calibrated entries'
-// tolerances (k_n, mu_s, mu_r) are PROVISIONAL until the accuracy study of
-// issue 5 measures the ci tier's seed-to-seed spread of each. Until then this
-// test is not part of tests/run_all.sh (README: "Table 3 in CI").
+// The ci tier (configs/calibration.yaml) turns a lambda = 32768 drum, where
+// Table 3's pair piles 9.7 deg steeper than at the paper's lambda = 64
+// (`granucal study fidelity`; README "What accuracy costs in time"); its
+// angle_offset_deg takes that bias out, so the run checks the pipeline, not
+// the coarse model's absolute angle. What the ci tier can then resolve is set
+// by its search, fixed before any run was compared with Table 3:
+//  - the initial design is a 2 x 2 grid at 1/4 and 3/4 of each axis of the
+//    unit square (mu_s linear, mu_r log10), so any point of the square is at
+//    most 1/4 of an axis from a grid point;
+//  - COBYLA then starts at the best grid point with steps of 1/4 and the tier
+//    allows it 2 evaluations: the start (already simulated) and one step.
+// A calibrated value can therefore be off by a quarter of its axis even when
+// every simulation were exact: 0.25 x 0.9 = 0.225 in mu_s (both bounds span
+// 0.1-1), 0.25 x 2.70 = 0.68 decades in granule mu_r (1e-3 - 0.5) and
+// 0.25 x 4.70 = 1.17 decades in wall mu_r (1e-5 - 0.5). These are the
+// tolerances; none was changed after a run.
 static const tolerance tolerances[] = {
     // Inputs and rules: the table must carry them exactly.
     {"granule-granule", "*", "density", 0, 1e-9, "config input (section 3.1)"},
@@ -15,12 +27,12 @@ static const tolerance tolerances[] = {
     {"granule-boundary", "*", "k_n", 1, 0.302, "2 k_n, springs in series (Table 3): follows k_n"},
     {"granule-boundary", "*", "k_s", 1, 0.302, "2 k_n (Table 3): follows k_n"},
     {"granule-boundary", "*", "k_r", 1, 0.302, "2 k_n (Table 3): follows k_n"},
-    // Calibrated (provisional, see above).
+    // Calibrated.
     {"granule-granule", "*", "k_n", 1, 0.302,
      "one rung of the candidate ladder (factor 2): stage 1 can only land on a candidate"},
-    {"granule-granule", "*", "mu_s", 0, 0.2, "provisional: the iso-angle ambiguity along mu_s at the ci tier"},
-    {"granule-granule", "*", "mu_r", 1, 0.5, "provisional: half a decade, mu_r compared on a log scale"},
-    {"granule-boundary", "*", "mu_s", 0, 0.3,
-     "provisional: the paper finds the angle nearly flat in the wall mu_s (section 4.3, Fig. 17)"},
-    {"granule-boundary", "*", "mu_r", 1, 1.0, "provisional: one decade; the wall mu_r spans decades (Fig. 17)"},
+    {"granule-granule", "*", "mu_s", 0, 0.225, "ci search resolution: 1/4 of the mu_s axis (0.1-1)"},
+    {"granule-granule", "*", "mu_r", 1, 0.68, "ci search resolution: 1/4 of the log mu_r axis (1e-3 - 0.5)"},
+    {"granule-boundary", "*", "mu_s", 0, 0.225, "ci search resolution: 1/4 of the mu_s axis (0.1-1)"},
+    {"granule-boundary", "*", "mu_r", 1, 1.17,
+     "ci search resolution: 1/4 of the log mu_r axis (1e-5 - 0.5); the wall mu_r spans decades (Fig. 17)"},
 };
