@@ -1,0 +1,294 @@
+// SPDX-License-Identifier: MIT
+// The poured cylinder (section 4.1) as a YAML scene: load, --set, validate,
+// run through exp_cylinder_run (the same pour as the calibration's stage 1),
+// report. See exp_cylinder_config.h.
+#include "exp_cylinder_config.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_output.h"
+#include "dem_scaling.h"
+#include "exp_pour.h"
+#include "exp_scene.h"
+#include "exp_yaml.h"
+
+// exp_cylinder.c settles until the kinetic energy ratio drops below this
+// (its SETTLE_KE_RATIO) or 2 s have passed: above it the bed is not at rest.
+#define REST_KE_RATIO 1e-6
+
+typedef struct cylinder_yaml {
+    char *experiment;
+    double diameter, depth, density, median_diameter, geometric_sd, truncation_sigmas, lambda;
+    double k_n, xi, mu_s, mu_r;
+    char *damping;
+    int seed;
+} cylinder_yaml;
+
+#define F(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_DEFAULT, cylinder_yaml, member)
+static const cyaml_schema_field_t cylinder_fields[] = {
+    CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, cylinder_yaml, experiment, 1, 16),
+    F("diameter", diameter), F("depth", depth), F("density", density), F("median_diameter", median_diameter),
+    F("geometric_sd", geometric_sd), F("truncation_sigmas", truncation_sigmas), F("lambda", lambda), F("k_n", k_n),
+    F("xi", xi), F("mu_s", mu_s), F("mu_r", mu_r),
+    CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cylinder_yaml, damping, 1, 32),
+    CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, cylinder_yaml, seed), CYAML_FIELD_END};
+#undef F
+static const cyaml_schema_value_t cylinder_schema = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cylinder_yaml, cylinder_fields)};
+
+int exp_is_cylinder_config(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char line[256];
+    int yes = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (line[0] == '#' || line[0] == '\n') continue;
+        yes = strncmp(line, "experiment: cylinder", 20) == 0;
+        break;
+    }
+    if (f) fclose(f);
+    return yes;
+}
+
+int exp_cylinder_check(const exp_cylinder_def *d, char *msg, size_t len)
+{
+    char sub[256];
+    if (!(isfinite(d->diameter) && d->diameter > 0)) return exp_fail(msg, len, "diameter = %g: must be > 0", d->diameter);
+    if (!(isfinite(d->depth) && d->depth > 0)) return exp_fail(msg, len, "depth = %g: must be > 0", d->depth);
+    if (!(isfinite(d->density) && d->density > 0)) return exp_fail(msg, len, "density = %g: must be > 0", d->density);
+    if (!(isfinite(d->lambda) && d->lambda >= 1) || dem_scale_check(d->lambda, sub, sizeof sub))
+        return exp_fail(msg, len, "lambda = %g: must be finite and >= 1 (lambda = N_real/N_scaled, eq. 15)", d->lambda);
+    if (dem_gsd_check(&d->gsd, sub, sizeof sub)) return exp_fail(msg, len, "%s", sub);
+    if (dem_contact_params_check(&d->granule, sub, sizeof sub)) return exp_fail(msg, len, "granule_contact.%s", sub);
+    if (dem_contact_params_check(&d->wall, sub, sizeof sub)) return exp_fail(msg, len, "wall_contact.%s", sub);
+    // The pour's lattice pitch is 1.05 d_max and keeps 0.55 pitch off the wall
+    // (exp_pour_to_rim): the container must hold a lattice point and a granule.
+    double dmax = dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda);
+    if (d->diameter < 2.2 * dmax || d->depth < dmax)
+        return exp_fail(msg, len,
+                        "lambda = %g: the largest scaled granule (%.3g m) does not fit the %.3g x %.3g m container",
+                        d->lambda, dmax, d->diameter, d->depth);
+    return 0;
+}
+
+static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t len)
+{
+    *d = exp_default_cylinder_def();
+    d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
+    d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
+    if (mode < 0)
+        return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
+    // Section 3.2: k_n = k_s = k_r. The container's friction is the granules'
+    // (as in the calibration's stage 1); exp_cylinder_run sets its stiffness
+    // to 2 k_n (Table 3: granule and wall springs in series).
+    d->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, y->mu_r, (dem_damping_mode)mode};
+    d->wall = d->granule;
+    d->seed = (uint64_t)y->seed;
+    return 0;
+}
+
+static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
+{
+    const char *eq = strchr(set, '=');
+    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
+    char key[32], *end;
+    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
+    errno = 0;
+    double v = strtod(eq + 1, &end);
+    if (errno || end == eq + 1 || *end || !isfinite(v))
+        return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    struct {
+        const char *name;
+        double *field;
+    } numbers[] = {{"k_n", &y->k_n},           {"mu_s", &y->mu_s},         {"mu_r", &y->mu_r},
+                   {"xi", &y->xi},             {"lambda", &y->lambda},     {"diameter", &y->diameter},
+                   {"depth", &y->depth},       {"density", &y->density}};
+    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
+        if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
+    if (strcmp(key, "seed") == 0) {
+        if (v < 0 || v != floor(v) || v > 2147483647.0)
+            return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", eq + 1);
+        y->seed = (int)v;
+        return 0;
+    }
+    return exp_fail(err, len,
+                    "--set %s: unknown key (known: k_n, mu_s, mu_r, xi, lambda, seed, diameter, depth, density)", key);
+}
+
+// The error for `field`: from a --set if one gave it, else located in the file.
+static int located(const char *path, int n_sets, char **sets, const char *field, const char *msg, char *err, size_t len)
+{
+    for (int k = n_sets - 1; k >= 0; --k) {
+        size_t n = strlen(field);
+        if (strncmp(sets[k], field, n) == 0 && sets[k][n] == '=')
+            return exp_fail(err, len, "--set %s: %s", sets[k], msg);
+    }
+    int line = exp_yaml_line_of(path, field, 1);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
+}
+
+int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_def *d, char *err, size_t len)
+{
+    cylinder_yaml *y = NULL;
+    if (exp_yaml_load(path, &cylinder_schema, (void **)&y, "check the keys and value types against configs/cylinder.yaml",
+                      err, len))
+        return 1;
+    char msg[300];
+    int bad = 0;
+    for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
+    if (!bad && strcmp(y->experiment, "cylinder") != 0)
+        bad = located(path, 0, NULL, "experiment", "must be cylinder", err, len);
+    if (!bad && y->seed < 0) {
+        snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
+        bad = located(path, 0, NULL, "seed", msg, err, len);
+    }
+    if (!bad && (to_def(y, d, msg, sizeof msg) || exp_cylinder_check(d, msg, sizeof msg))) {
+        // Messages start with the field: "depth = ...", "granule_contact.mu_s = ...",
+        // "gsd.geometric_sd = ..."; the YAML key is the last part.
+        char field[48];
+        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
+        const char *leaf = strrchr(field, '.');
+        bad = located(path, n_sets, sets, leaf ? leaf + 1 : field, msg, err, len);
+    }
+    exp_yaml_free(&cylinder_schema, y);
+    return bad;
+}
+
+// ------------------------------------------------------------ run + report
+
+typedef struct progress_state {
+    int verbose;
+    double last_print, start;
+    double last_t, granule_seconds; ///< Σ granules × simulated time, for the particle-step estimate
+} progress_state;
+
+static void on_progress(const char *phase, double t, size_t granules, void *ctx)
+{
+    progress_state *p = ctx;
+    // exp_run_for reports after each chunk of steps, with the granules the chunk ran.
+    if (t > p->last_t) p->granule_seconds += (t - p->last_t) * (double)granules;
+    p->last_t = t;
+    if (!p->verbose) return;
+    double now = exp_wall_seconds();
+    if (now - p->last_print < 10.0) return;
+    p->last_print = now;
+    fprintf(stderr, "cylinder: %s t = %.2f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
+}
+
+dem_world *exp_cylinder_pour_and_report(const exp_cylinder_def *d, int verbose, exp_cylinder_result *r,
+                                        exp_cylinder_report *rep, char *err, size_t len)
+{
+    memset(rep, 0, sizeof *rep);
+    progress_state p = {verbose, 0, exp_wall_seconds(), 0, 0};
+    p.last_print = p.start;
+    dem_world *w = exp_cylinder_run(d, on_progress, &p, r, err, len);
+    rep->wall_time_s = exp_wall_seconds() - p.start;
+    if (!w) return NULL;
+    dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
+    rep->ke_ratio = exp_ke_ratio(w, gsd.median_diameter);
+    rep->particle_steps_est = dem_world_dt(w) > 0 ? p.granule_seconds / dem_world_dt(w) : 0;
+    rep->bed_surface_m = exp_bed_surface(w, 0);
+    dem_granules_view g = dem_world_granules(w);
+    for (size_t i = 0; i < g.count; ++i) rep->bed_top_m = fmax(rep->bed_top_m, g.position[i].y + g.radius[i]);
+    return w;
+}
+
+static void json_number(FILE *f, const char *key, double v, const char *fmt)
+{
+    fprintf(f, ", \"%s\": ", key);
+    if (isfinite(v)) fprintf(f, fmt, v);
+    else fputs("null", f); // JSON has no NaN (no interior granule at a coarse lambda)
+}
+
+void exp_cylinder_write_json(FILE *f, const exp_cylinder_def *d, const exp_cylinder_result *r,
+                             const exp_cylinder_report *rep, const dem_world *w)
+{
+    char effects[1024];
+    dem_world_describe_features(w, effects, sizeof effects);
+    fprintf(f,
+            "{\"experiment\": \"cylinder\", \"status\": \"%s\", \"k_n\": %g, \"wall_k_n\": %g, \"mu_s\": %g, "
+            "\"mu_r\": %g, \"xi\": %g, \"lambda\": %g, \"seed\": %llu, \"diameter_m\": %g, \"depth_m\": %g, "
+            "\"granules\": %zu",
+            rep->ke_ratio < REST_KE_RATIO ? "ok" : "not at rest", d->granule.k_n, 2 * d->granule.k_n, d->granule.mu_s,
+            d->granule.mu_r, d->granule.xi, d->lambda, (unsigned long long)d->seed, d->diameter, d->depth,
+            r->granules);
+    json_number(f, "coordination", r->coordination, "%.4f");
+    json_number(f, "coordination_interior", r->coordination_interior, "%.4f");
+    json_number(f, "wall_contacts_per_granule", r->wall_contacts_per_granule, "%.4f");
+    json_number(f, "coordination_with_walls", r->coordination + r->wall_contacts_per_granule, "%.4f");
+    json_number(f, "solid_fraction", r->solid_fraction, "%.4f");
+    json_number(f, "bed_surface_m", rep->bed_surface_m, "%.5g");
+    json_number(f, "bed_top_m", rep->bed_top_m, "%.5g");
+    json_number(f, "ke_ratio", rep->ke_ratio, "%.3g");
+    fprintf(f,
+            ", \"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"particle_steps_est\": %.0f, \"dt_s\": %.6g, "
+            "\"effects\": \"%s\"}\n",
+            r->simulated_time_s, rep->wall_time_s, rep->particle_steps_est, dem_world_dt(w), effects);
+}
+
+int exp_cylinder_write_outputs(const char *dir, const exp_cylinder_def *d, const exp_cylinder_result *r,
+                               const exp_cylinder_report *rep, const dem_world *w, char *err, size_t len)
+{
+    char path[1100], tmp[1200];
+    if (exp_mkdirs(dir, err, len)) return 1;
+    snprintf(path, sizeof path, "%s/result.h5", dir);
+    dem_h5_writer *h5 = dem_h5_open(path, err, len);
+    if (!h5) return 1;
+    dem_granules_view g = dem_world_granules(w);
+    dem_diagnostics dg = dem_world_diagnose(w);
+    int bad = dem_h5_write_frame(h5, dem_world_time(w), &g, &dg) ||
+              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
+    if (bad) exp_fail(err, len, "%s", dem_h5_error(h5));
+    if (dem_h5_close(h5, bad ? NULL : err, bad ? 0 : len)) bad = 1;
+    if (bad) return 1;
+    snprintf(path, sizeof path, "%s/result.json", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (f) exp_cylinder_write_json(f, d, r, rep, w);
+    if (!f || fclose(f) != 0 || rename(tmp, path) != 0) {
+        remove(tmp);
+        return exp_fail(err, len, "cannot write '%s'", path);
+    }
+    return 0;
+}
+
+int exp_cylinder_simulate(const char *path, int n_sets, char **sets, const char *out)
+{
+    char err[1400], dir[1024];
+    exp_cylinder_def d;
+    if (exp_cylinder_load(path, n_sets, sets, &d, err, sizeof err))
+        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/cylinder");
+    if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    exp_cylinder_result r;
+    exp_cylinder_report rep;
+    dem_world *w = exp_cylinder_pour_and_report(&d, 1, &r, &rep, err, sizeof err);
+    if (!w) {
+        fprintf(stderr, "granucal simulate: %s\n", err);
+        printf("{\"experiment\": \"cylinder\", \"status\": \"failed\", \"error\": \"");
+        for (const char *c = err; *c; ++c) // a JSON string: escape quotes, backslashes, control characters
+            if (*c == '"' || *c == '\\') printf("\\%c", *c);
+            else if ((unsigned char)*c < 0x20) printf("\\u%04x", (unsigned)(unsigned char)*c);
+            else putchar(*c);
+        printf("\"}\n");
+        return 1;
+    }
+    fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));
+    int bad = exp_cylinder_write_outputs(dir, &d, &r, &rep, w, err, sizeof err);
+    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
+    exp_cylinder_write_json(stdout, &d, &r, &rep, w);
+    if (!(rep.ke_ratio < REST_KE_RATIO))
+        fprintf(stderr,
+                "granucal simulate: the settle stopped at its time limit (kinetic energy ratio %.3g, at rest below "
+                "%.0e): status \"not at rest\"; the contacts are counted as they are\n",
+                rep.ke_ratio, REST_KE_RATIO);
+    dem_world_destroy(w);
+    return bad;
+}
