@@ -397,19 +397,7 @@ static const cyaml_schema_field_t compress_fields[] = {
 static const cyaml_schema_value_t compress_schema = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, compress_yaml, compress_fields)};
 
-int exp_is_compress_config(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    char line[256];
-    int yes = 0;
-    while (f && fgets(line, sizeof line, f)) {
-        if (line[0] == '#' || line[0] == '\n') continue;
-        yes = strncmp(line, "experiment: compression", 23) == 0;
-        break;
-    }
-    if (f) fclose(f);
-    return yes;
-}
+int exp_is_compress_config(const char *path) { return exp_yaml_starts_with(path, "experiment: compression"); }
 
 static int located(const char *path, const char *field, char *err, size_t len, const char *msg)
 {

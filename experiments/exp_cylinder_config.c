@@ -41,19 +41,7 @@ static const cyaml_schema_field_t cylinder_fields[] = {
 static const cyaml_schema_value_t cylinder_schema = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cylinder_yaml, cylinder_fields)};
 
-int exp_is_cylinder_config(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    char line[256];
-    int yes = 0;
-    while (f && fgets(line, sizeof line, f)) {
-        if (line[0] == '#' || line[0] == '\n') continue;
-        yes = strncmp(line, "experiment: cylinder", 20) == 0;
-        break;
-    }
-    if (f) fclose(f);
-    return yes;
-}
+int exp_is_cylinder_config(const char *path) { return exp_yaml_starts_with(path, "experiment: cylinder"); }
 
 int exp_cylinder_check(const exp_cylinder_def *d, char *msg, size_t len)
 {

@@ -42,19 +42,7 @@ static const cyaml_schema_field_t drum_fields[] = {
 static const cyaml_schema_value_t drum_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, exp_drum_yaml, drum_fields)};
 
 
-int exp_is_drum_config(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    char line[256];
-    int drum = 0;
-    while (f && fgets(line, sizeof line, f)) {
-        if (line[0] == '#' || line[0] == '\n') continue;
-        drum = strncmp(line, "experiment: drum", 16) == 0;
-        break;
-    }
-    if (f) fclose(f);
-    return drum;
-}
+int exp_is_drum_config(const char *path) { return exp_yaml_starts_with(path, "experiment: drum"); }
 
 static int parse_number(const char *text, double *out)
 {

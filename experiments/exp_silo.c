@@ -372,19 +372,7 @@ static const cyaml_schema_field_t silo_fields[] = {
 #undef F
 static const cyaml_schema_value_t silo_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, silo_yaml, silo_fields)};
 
-int exp_is_silo_config(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    char line[256];
-    int yes = 0;
-    while (f && fgets(line, sizeof line, f)) {
-        if (line[0] == '#' || line[0] == '\n') continue;
-        yes = strncmp(line, "experiment: silo", 16) == 0;
-        break;
-    }
-    if (f) fclose(f);
-    return yes;
-}
+int exp_is_silo_config(const char *path) { return exp_yaml_starts_with(path, "experiment: silo"); }
 
 static void to_def(const silo_yaml *y, exp_silo_def *d)
 {

@@ -84,3 +84,17 @@ void exp_yaml_free(const cyaml_schema_value_t *schema, void *data)
 {
     if (data) cyaml_free(&quiet, schema, data, 0);
 }
+
+int exp_yaml_starts_with(const char *path, const char *first)
+{
+    FILE *f = fopen(path, "r");
+    char line[256];
+    int yes = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (line[0] == '#' || line[0] == '\n') continue;
+        yes = strncmp(line, first, strlen(first)) == 0;
+        break;
+    }
+    if (f) fclose(f);
+    return yes;
+}

@@ -18,4 +18,9 @@ int exp_yaml_load(const char *path, const cyaml_schema_value_t *schema, void **o
 /// Free what exp_yaml_load loaded.
 void exp_yaml_free(const cyaml_schema_value_t *schema, void *data);
 
+/// 1 if the file's first line that is not blank or a comment starts with
+/// `first` (e.g. "experiment: drum"): how `granucal simulate` tells its
+/// experiment configs apart.
+int exp_yaml_starts_with(const char *path, const char *first);
+
 #endif
