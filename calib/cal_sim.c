@@ -3,6 +3,7 @@
 #include "cal_sim.h"
 
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -145,12 +146,24 @@ typedef struct drum_batch {
     char err[512];
 } drum_batch;
 
-static int write_failed(const cal_env *env, const char *key, const char *reason)
+static int write_failed_record(const cal_env *env, const char *key, const char *reason, int retry)
 {
     char err[512];
-    cal_record r = {.key = (char *)key, .status = "failed", .reason = (char *)reason};
+    cal_record r = {.key = (char *)key, .status = "failed", .reason = (char *)reason, .retry = retry};
     if (cal_store_put(env->store, &r, err, sizeof err)) return fprintf(stderr, "granucal calibrate: %s\n", err), 1;
     return 0;
+}
+
+static int write_failed(const cal_env *env, const char *key, const char *reason)
+{
+    return write_failed_record(env, key, reason, 0);
+}
+
+// Killed from outside (a user, the OOM killer, a kill of the whole run), as
+// opposed to a crash of the simulation itself (SIGSEGV, SIGABRT, SIGFPE, ...).
+static int killed_from_outside(int sig)
+{
+    return sig == SIGKILL || sig == SIGTERM || sig == SIGINT || sig == SIGHUP || sig == SIGQUIT;
 }
 
 static int turn_one(int i, void *ctx)
@@ -188,9 +201,11 @@ static void finish_task(cal_env *env, const char *key, const char *what, int cod
 {
     char err[512];
     if (code < 0) {
-        char reason[64];
-        snprintf(reason, sizeof reason, "the simulation process died (signal %d)", -code);
-        write_failed(env, key, reason);
+        char reason[96];
+        int outside = killed_from_outside(-code);
+        snprintf(reason, sizeof reason, "the simulation process died (signal %d%s)", -code,
+                 outside ? ", killed from outside: a later run retries it" : "");
+        write_failed_record(env, key, reason, outside);
     }
     cal_record r;
     if (cal_store_get(env->store, key, &r, err, sizeof err) == 0) {

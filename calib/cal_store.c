@@ -26,8 +26,23 @@ static const cyaml_schema_field_t record_fields[] = {
     CYAML_FIELD_BOOL("steady", CYAML_FLAG_OPTIONAL, cal_record, steady), REC_FLOAT("simulated_time_s", simulated_time_s),
     REC_FLOAT("wall_time_s", wall_time_s), REC_FLOAT("dt_s", dt_s), REC_FLOAT("particle_steps", particle_steps),
     REC_FLOAT("fill_wall_time_s", fill_wall_time_s), REC_FLOAT("peak_rss_mb", peak_rss_mb),
+    CYAML_FIELD_BOOL("retry", CYAML_FLAG_OPTIONAL, cal_record, retry),
+    CYAML_FIELD_STRING_PTR("writer", CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, cal_record, writer, 0, 256),
     CYAML_FIELD_INT("granules", CYAML_FLAG_OPTIONAL, cal_record, granules), CYAML_FIELD_END};
 static const cyaml_schema_value_t record_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_record, record_fields)};
+
+// This run, as written into every record: "host:pid".
+static const char *this_run(void)
+{
+    static char id[128];
+    if (!id[0]) {
+        char host[64] = "host";
+        gethostname(host, sizeof host - 1);
+        host[sizeof host - 1] = 0;
+        snprintf(id, sizeof id, "%s:%ld", host, (long)getpid());
+    }
+    return id;
+}
 
 void cal_store_hash(const char *key, char out[17])
 {
@@ -59,6 +74,10 @@ int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, 
     }
     *out = *r;
     free(r); // the strings now belong to *out
+    if (out->retry && (!out->writer || strcmp(out->writer, this_run()) != 0)) {
+        cal_record_free(out); // an earlier run's process was killed: run it again
+        return 1;
+    }
     return 0;
 }
 
@@ -82,6 +101,8 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
     put_quoted(a.f, "key", r->key);
     put_quoted(a.f, "status", r->status);
     put_quoted(a.f, "reason", r->reason ? r->reason : "");
+    put_quoted(a.f, "writer", this_run());
+    fprintf(a.f, "retry: %s\n", r->retry ? "true" : "false");
     fprintf(a.f,
             "angle_deg: %.17g\nangle_sd_deg: %.17g\ncsa_percent: %.17g\ncsa_sd_percent: %.17g\n"
             "coordination: %.17g\ncoordination_interior: %.17g\nwall_contacts_per_granule: %.17g\n"
@@ -96,8 +117,8 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
 
 void cal_record_free(cal_record *r)
 {
-    free(r->key), free(r->status), free(r->reason);
-    r->key = r->status = r->reason = NULL;
+    free(r->key), free(r->status), free(r->reason), free(r->writer);
+    r->key = r->status = r->reason = r->writer = NULL;
 }
 
 int cal_record_usable(const cal_record *r) { return r->status && strcmp(r->status, "failed") != 0; }

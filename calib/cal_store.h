@@ -23,6 +23,9 @@ typedef struct cal_record {
     double fill_wall_time_s; ///< settling the bed, charged to the first speed turned from it (else 0)
     double peak_rss_mb;      ///< peak resident memory of the process that ran it
     int granules;
+    int retry;               ///< a failure of the process, not of the simulation (killed from
+                             ///< outside): valid for the run that wrote it, rerun by any later one
+    char *writer;            ///< "host:pid" of the run that wrote it (set by cal_store_put)
 } cal_record;
 
 /// 64-bit FNV-1a of the key, as 16 hex digits.
@@ -33,6 +36,7 @@ void cal_store_path(const char *dir, const char *key, char *out, size_t len);
 
 /// Read the record of `key`: 0 found (fields filled, free with
 /// cal_record_free), 1 absent, -1 unreadable or a different key (message).
+/// A retry record written by another run counts as absent.
 int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len);
 
 /// Write a record atomically. 0 on success.

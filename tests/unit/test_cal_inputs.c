@@ -261,6 +261,26 @@ static void test_store_round_trip_and_collision_check(void **state)
     assert_int_equal(rename(other, path), 0);
     assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
     assert_non_null(strstr(err, "different simulation"));
+    // A failure of the process (killed from outside) holds for the run that
+    // recorded it, and a later run runs the simulation again.
+    cal_record killed = {.key = "killed run", .status = "failed", .reason = "signal 9", .retry = 1};
+    assert_int_equal(cal_store_put(dir, &killed, err, sizeof err), 0);
+    assert_int_equal(cal_store_get(dir, killed.key, &back, err, sizeof err), 0); // this run wrote it
+    assert_true(back.retry && !cal_record_usable(&back));
+    cal_record_free(&back);
+    char killed_path[1200], text[4096];
+    cal_store_path(dir, killed.key, killed_path, sizeof killed_path);
+    FILE *kf = fopen(killed_path, "r");
+    assert_non_null(kf);
+    size_t kn = fread(text, 1, sizeof text - 1, kf);
+    text[kn] = 0;
+    fclose(kf);
+    char *w = strstr(text, "writer: '");
+    assert_non_null(w);
+    memcpy(w + 9, "~", 1); // another run's writer id
+    write_file(killed_path, text);
+    assert_int_equal(cal_store_get(dir, killed.key, &back, err, sizeof err), 1); // a later run: absent
+    unlink(killed_path);
     // A damaged record is an error naming the file, not a crash.
     write_file(path, "key: 'x\nstatus: [\n");
     assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
