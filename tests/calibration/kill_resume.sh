@@ -10,7 +10,15 @@ cd "$src"
 args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 2)
 "$bin" "${args[@]}" --out "$work/whole" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
 total=$(($(wc -l < "$work/whole/simulations.csv") - 1))
-records() { ls "$work/killed/store" 2>/dev/null | grep -c '\.yaml$' || true; }
+# Stored = a record a rerun keeps: not one marking a worker killed from outside (retry: true),
+# which the next run runs again by design.
+records() {
+  local n=0 f
+  for f in "$work/killed/store"/*.yaml; do
+    [ -e "$f" ] && ! grep -q '^retry: true' "$f" && n=$((n + 1))
+  done
+  echo "$n"
+}
 # Five kill points spread over the run: once N records are stored (0 = during the first
 # fill), 2 s later, in whatever phase that is (filling, turning, writing), SIGKILL the
 # driver and its workers; then the same command again.
@@ -24,7 +32,7 @@ for target in 0 1 3 4 6; do
   wait "$pid" 2>/dev/null || true
   echo "killed once ${target}+ records were stored, 2 s later: $(records) stored"
 done
-before=$(ls "$work/killed/store" | grep -c '\.yaml$')
+before=$(records)
 stamp=$(mktemp)
 "$bin" "${args[@]}" --out "$work/killed" > "$work/resume.log" 2>&1 || { cat "$work/resume.log"; exit 1; }
 diff "$work/whole/calibrated_parameters.csv" "$work/killed/calibrated_parameters.csv"
