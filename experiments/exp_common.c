@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/resource.h>
@@ -26,6 +27,19 @@ double exp_wall_seconds(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len)
+{
+    const char *eq = strchr(set, '=');
+    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
+    snprintf(key, 32, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
+    char *end;
+    errno = 0;
+    *value = strtod(eq + 1, &end);
+    if (errno || end == eq + 1 || *end || !isfinite(*value))
+        return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    return 0;
 }
 
 double exp_peak_rss_mb(void)

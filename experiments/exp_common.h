@@ -19,6 +19,10 @@ int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(
 /// Seconds of wall-clock time (monotonic) since an arbitrary origin.
 double exp_wall_seconds(void);
 
+/// Split a `--set key=value` whose value must be a finite number: 0, else 1
+/// with a message naming the key.
+int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len);
+
 /// Peak resident memory of this process so far, MiB (getrusage).
 double exp_peak_rss_mb(void);
 

@@ -83,14 +83,9 @@ static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t
 
 static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
 {
-    const char *eq = strchr(set, '=');
-    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
-    char key[32], *end;
-    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
-    errno = 0;
-    double v = strtod(eq + 1, &end);
-    if (errno || end == eq + 1 || *end || !isfinite(v))
-        return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    char key[32];
+    double v;
+    if (exp_parse_set(set, key, &v, err, len)) return 1;
     struct {
         const char *name;
         double *field;
@@ -101,7 +96,7 @@ static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
         if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
     if (strcmp(key, "seed") == 0) {
         if (v < 0 || v != floor(v) || v > 2147483647.0)
-            return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", eq + 1);
+            return exp_fail(err, len, "--set seed: %g is not a non-negative integer", v);
         y->seed = (int)v;
         return 0;
     }

@@ -391,20 +391,16 @@ static void to_def(const silo_yaml *y, exp_silo_def *d)
 
 static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
 {
-    const char *eq = strchr(set, '=');
-    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
-    char key[32], *end;
-    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
-    errno = 0;
-    double v = strtod(eq + 1, &end);
-    if (errno || end == eq + 1 || *end || !isfinite(v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    char key[32];
+    double v;
+    if (exp_parse_set(set, key, &v, err, len)) return 1;
     struct { const char *name; double *field; } numbers[] = {
         {"k_n", &y->k_n}, {"mu_s", &y->mu_s}, {"duration", &y->duration}, {"orifice_radius", &y->orifice_radius},
         {"silo_radius", &y->silo_radius}, {"plate_z", &y->plate_z}, {"dt", &y->dt}, {"xi", &y->xi}};
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
     if (strcmp(key, "seed") == 0 || strcmp(key, "n_granules") == 0) {
-        if (v < 0 || v != floor(v) || v > 2147483647.0) return exp_fail(err, len, "--set %s: '%s' is not a non-negative integer", key, eq + 1);
+        if (v < 0 || v != floor(v) || v > 2147483647.0) return exp_fail(err, len, "--set %s: %g is not a non-negative integer", key, v);
         *(strcmp(key, "seed") == 0 ? &y->seed : &y->n_granules) = (int)v;
         return 0;
     }
