@@ -385,9 +385,11 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
             fprintf(f, "Chosen: **k_n = %g N/m**, the smallest k from which every stiffer candidate stays within the "
                        "tolerance.\n", s->chosen_k);
         else
-            fprintf(f, "**Unresolved:** even the softest candidate (%g N/m) is within the tolerance, so this tier's sweep "
-                       "shows no change to stop at; the config's k_n = %g N/m was used. A finer cylinder (smaller "
-                       "cylinder_lambda: more layers, more pressure) resolves it.\n", s->k[0], o->config->k_n);
+            fprintf(f, "**Unresolved:** the coordination number does not depart from its stiff limit all the way down "
+                       "to the softest candidate (%g N/m): some softer candidate is within the tolerance, so what this "
+                       "tier's sweep shows is noise, with no change to stop at; the config's k_n = %g N/m was used. A "
+                       "finer cylinder (smaller cylinder_lambda: more layers, more pressure) resolves it.\n",
+                    s->k[0], o->config->k_n);
     }
     if (o->granule) report_friction(f, o->granule);
     for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w]);

@@ -45,17 +45,22 @@ static double noise_tolerance(const cal_stiffness_result *s, int seeds)
     return 2 * pooled * sqrt(2.0 / seeds);
 }
 
-static void choose(cal_stiffness_result *s)
+void cal_stiffness_choose(cal_stiffness_result *s)
 {
     s->chosen_k = NAN;
+    int first = s->n; // the softest candidate of the run within the noise of the stiff limit
     for (int i = s->n - 1; i >= 0; --i) {
         if (!isfinite(s->cn_mean[i]) || fabs(s->cn_mean[i] - s->stiff_limit) > s->tolerance) break;
-        s->chosen_k = s->k[i];
+        s->chosen_k = s->k[i], first = i;
     }
-    // If the softest candidate is already within the noise of the stiff
-    // limit, the sweep never saw the CN change: at this fidelity (few
-    // layers, little pressure) it cannot say where the change stops.
-    s->resolved = isfinite(s->chosen_k) && s->chosen_k > s->k[0];
+    // The CN departs from its stiff limit as k softens (more overlap, more
+    // contacts: Fig. 12), so a real change persists down to the softest
+    // candidate. If any softer candidate is back within the noise, the one
+    // outside was noise too, and at this fidelity (few layers, little
+    // pressure) the sweep cannot say where the change stops.
+    s->resolved = isfinite(s->chosen_k) && first > 0;
+    for (int i = 0; i < first && s->resolved; ++i)
+        s->resolved = isfinite(s->cn_mean[i]) && fabs(s->cn_mean[i] - s->stiff_limit) > s->tolerance;
 }
 
 int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, cal_stiffness_result *out, char *err,
@@ -83,7 +88,7 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
         out->tolerance_rule = c->stiffness_tolerance > 0 ? "stiffness_tolerance of the config"
                                                           : "two standard errors of a difference of seed means";
         if (!isfinite(out->stiff_limit)) bad = exp_fail(err, len, "the stiffest cylinder (k_n = %g N/m) failed every seed", out->k[n - 1]);
-        else choose(out);
+        else cal_stiffness_choose(out);
     }
     for (int i = 0; i < n * seeds; ++i) cal_record_free(&rec[i]);
     free(cases), free(rec);

@@ -30,6 +30,12 @@ typedef struct cal_stiffness_result {
 int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, cal_stiffness_result *out, char *err,
                         size_t len);
 
+/// Stage 1's rule on measured k, cn_mean, stiff_limit and tolerance: the
+/// smallest k from which every stiffer candidate is within the tolerance of
+/// the stiff limit (chosen_k), resolved only if every softer candidate is
+/// outside it (the departure persists as k softens).
+void cal_stiffness_choose(cal_stiffness_result *s);
+
 /// One evaluated (μs, μr) candidate.
 typedef struct cal_candidate {
     double mu_s, mu_r;

@@ -16,6 +16,7 @@
 
 #include "cal_config.h"
 #include "cal_data.h"
+#include "cal_stages.h"
 #include "cal_store.h"
 #include "cal_util.h"
 #include "exp_drum_config.h"
@@ -317,6 +318,33 @@ static void test_sweep_removes_only_dead_writers_temporaries(void **state)
     rmdir(dir);
 }
 
+// Stage 1's rule (cal_stiffness_choose). A CN that departs from its stiff
+// limit all the way down to the softest k is resolved at the stiffest k the
+// departure stops at; the ci tier's measured pattern, one candidate outside
+// with a softer one back inside, is noise and unresolved.
+static void test_stiffness_rule(void **state)
+{
+    (void)state;
+    cal_stiffness_result s = {.n = 5, .k = {50, 100, 200, 400, 800}, .tolerance = 0.1};
+    const double monotone[5] = {4.1, 3.6, 3.25, 3.22, 3.2};
+    for (int i = 0; i < 5; ++i) s.cn_mean[i] = monotone[i];
+    s.stiff_limit = s.cn_mean[4];
+    cal_stiffness_choose(&s);
+    assert_true(s.resolved);
+    assert_true(s.chosen_k == 200);
+    const double ci_tier[5] = {2.796, 2.875, 2.641, 2.716, 2.448}; // results/table3_ci, tolerance 0.404
+    for (int i = 0; i < 5; ++i) s.cn_mean[i] = ci_tier[i];
+    s.stiff_limit = s.cn_mean[4], s.tolerance = 0.404;
+    cal_stiffness_choose(&s);
+    assert_true(s.chosen_k == 200); // 100 N/m is 0.427 away, 50 N/m back within 0.348
+    assert_false(s.resolved);
+    const double flat[5] = {3.0, 3.01, 2.99, 3.0, 3.0};
+    for (int i = 0; i < 5; ++i) s.cn_mean[i] = flat[i];
+    s.stiff_limit = 3.0, s.tolerance = 0.1;
+    cal_stiffness_choose(&s);
+    assert_false(s.resolved);
+}
+
 int main(void)
 {
     const char *s = getenv("GRANUCAL_SOURCE_DIR");
@@ -330,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_fuzz_findings_refused),
         cmocka_unit_test(test_store_round_trip_and_collision_check),
         cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
+        cmocka_unit_test(test_stiffness_rule),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
