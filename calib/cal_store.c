@@ -36,9 +36,8 @@ static const char *this_run(void)
 {
     static char id[128];
     if (!id[0]) {
-        char host[64] = "host";
-        gethostname(host, sizeof host - 1);
-        host[sizeof host - 1] = 0;
+        char host[64];
+        cal_host_name(host);
         snprintf(id, sizeof id, "%s:%ld", host, (long)getpid());
     }
     return id;

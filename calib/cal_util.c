@@ -21,7 +21,7 @@ int cal_mkdirs(const char *path, char *err, size_t err_len)
     return 0;
 }
 
-static void this_host(char host[64])
+void cal_host_name(char host[64])
 {
     snprintf(host, 64, "host");
     gethostname(host, 63);
@@ -33,7 +33,7 @@ void cal_temporary_name(const char *path, char *tmp, size_t len)
     // Per host and process: two ranks never share a temporary, and a later run can tell
     // which temporaries belonged to a process that died (cal_atomic_sweep).
     char host[64];
-    this_host(host);
+    cal_host_name(host);
     snprintf(tmp, len, "%s.%s.%ld.tmp", path, host, (long)getpid());
 }
 
@@ -110,7 +110,7 @@ static int temporary_of_this_host(const char *name, const char *host, long *pid)
 int cal_atomic_sweep(const char *dir)
 {
     char host[64];
-    this_host(host);
+    cal_host_name(host);
     DIR *d = opendir(dir);
     if (!d) return 0;
     int removed = 0;

@@ -16,6 +16,9 @@ int cal_mkdirs(const char *path, char *err, size_t err_len);
 /// a bad folder is an error before any work starts. 0, else 1 with a message.
 int cal_prepare_output(const char *dir, char *err, size_t len);
 
+/// This machine's host name ("host" if it cannot be read), at most 63 bytes.
+void cal_host_name(char host[64]);
+
 /// The temporary name a file is written under before it is renamed to @p path:
 /// PATH.HOST.PID.tmp, so cal_atomic_sweep can tell a dead writer's leftovers.
 void cal_temporary_name(const char *path, char *tmp, size_t len);
