@@ -78,7 +78,7 @@ static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
     snprintf(out, len,
              "drum v=%s D=%.10g depth=%.10g periodic=%d fill=%.10g lambda=%.10g rho=%.10g gsd=%.10g,%.10g,%.10g "
              "granule[%s] wall[%s] plate[%s] pixel=%.10g closing=%d seed=%llu",
-             exp_version(), d->diameter, d->depth, d->periodic, d->fill, d->lambda, d->density, d->gsd.median_diameter,
+             exp_results_version(), d->diameter, d->depth, d->periodic, d->fill, d->lambda, d->density, d->gsd.median_diameter,
              d->gsd.geometric_sd, d->gsd.truncation_sigmas, gg, wall, d->periodic ? "none" : plate, d->pixel,
              d->closing_px, (unsigned long long)d->seed);
 }
@@ -107,7 +107,7 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
     contact_text(gg, sizeof gg, &c->granule), contact_text(wall, sizeof wall, &c->wall);
     snprintf(out, len, "cylinder v=%s D=%.10g depth=%.10g lambda=%.10g rho=%.10g gsd=%.10g,%.10g,%.10g granule[%s] "
                        "wall[%s] seed=%llu",
-             exp_version(), c->diameter, c->depth, c->lambda, c->density, c->gsd.median_diameter, c->gsd.geometric_sd,
+             exp_results_version(), c->diameter, c->depth, c->lambda, c->density, c->gsd.median_diameter, c->gsd.geometric_sd,
              c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
 }
 

@@ -120,7 +120,7 @@ int dem_contact_params_check(const dem_contact_params *p, char *msg, unsigned lo
 /// with the pair about n (twist), project it onto the plane normal to n, and
 /// rescale it to its old length (Luding 2008), so rigid motion of the pair
 /// neither creates nor destroys spring length.
-static inline dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twist)
+static DEM_ALWAYS_INLINE dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twist)
 {
     double len2 = dem_v3_norm2(spring);
     if (len2 == 0.0) return spring;
@@ -135,7 +135,7 @@ static inline dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twis
 /// limit: F = −k·δ, |F| ≤ μ|F_n|; on truncation the spring is reset so that
 /// k|δ| equals the limit (eq. 6+8 for sliding, eq. 11+13 for rolling).
 /// `*sticking` becomes 1 if the spring stayed below the limit.
-static inline dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist, dem_vec3 vel, double dt,
+static DEM_ALWAYS_INLINE dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist, dem_vec3 vel, double dt,
                                          double k, double inv_k, double limit, int *sticking)
 {
     dem_vec3 spring = dem_spring_carry(dem_v3(hist[0], hist[1], hist[2]), n, twist);
@@ -157,7 +157,7 @@ static inline dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist,
 /// the call site. `hist` holds dem_history_len(features) doubles: tangential
 /// spring δ_s first (if on), then rolling spring δ_r (if on); zero for a new
 /// contact. Springs store displacements; forces are −k·δ.
-static inline void dem_contact_eval(const dem_contact_coeffs *c, const dem_contact_state *s, double *hist,
+static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, const dem_contact_state *s, double *hist,
                                     dem_contact_out *out, const unsigned features)
 {
     const dem_vec3 n = s->normal;

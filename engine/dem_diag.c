@@ -70,6 +70,8 @@ dem_diagnostics dem_world_diagnose(const dem_world *w)
     d.time = w->time;
     d.step = w->step;
     d.granules = w->n;
+    d.list_pairs = w->list_valid ? w->nl.count : 0;
+    d.list_rebuilds = w->rebuilds;
     for (size_t i = 0; i < w->n; ++i) {
         d.ke_translational += 0.5 * w->mass[i] * dem_v3_norm2(w->vel[i]);
         d.ke_rotational += 0.5 * w->inertia[i] * dem_v3_norm2(w->omg[i]);

@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "dem_world_internal.h"
 
 // Granules per chunk of a dot product: partial sums in fixed chunks, added in
@@ -52,6 +54,13 @@ static inline void dem_imp_add_block(double *b, dem_vec3 n, double g, double kt,
         }
 }
 
+// Whether the pair loop runs on several threads (per-pair slots and a
+// gather) or on one (forces added directly).
+static inline int dem_forces_threaded(const dem_world *w)
+{
+    return w->n >= DEM_OMP_MIN_GRANULES && omp_get_max_threads() > 1;
+}
+
 static void *grow_to(void *p, size_t bytes, int *fail)
 {
     void *q = realloc(p, bytes ? bytes : 1);
@@ -91,19 +100,40 @@ void dem_imp_scratch_free(dem_imp_scratch *s)
     memset(s, 0, sizeof *s);
 }
 
-static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const unsigned mask)
+// How a pair loop hands its forces on. DIRECT adds them straight to both
+// granules (one thread); SLOTS writes them into per-pair slots that gather()
+// sums per granule (several threads, no two writing the same memory). Both add
+// the same terms in the same order, so the results are bitwise identical:
+// granule j first receives its pairs as partner (rows i < j, ascending), then
+// its own row.
+enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
+
+// Minimum image along the periodic axis for a separation shorter than one
+// period (both centres are wrapped into the domain): one compare per pair
+// instead of a division and a rounding.
+static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(dem_vec3 d, int axis, double len)
+{
+    double *c = axis == 0 ? &d.x : axis == 1 ? &d.y : &d.z;
+    if (*c > 0.5 * len) *c -= len;
+    else if (*c < -0.5 * len) *c += len;
+    return d;
+}
+
+static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t k, const unsigned mask,
+                                         const int direct, int axis, double len)
 {
     const uint32_t j = w->nl.j[k];
     const int hl = dem_history_len(mask);
-    double *hist = w->nl.hist + k * (size_t)hl;
-    dem_vec3 d = dem_v3_sub(w->pos[j], w->pos[i]);
-    if (mask & DEM_FEAT_PERIODIC) d = dem_world_min_image(w, d);
+    double *restrict hist = w->nl.hist + k * (size_t)hl;
+    const dem_vec3 *restrict pos = w->pos;
+    dem_vec3 d = dem_v3_sub(pos[j], pos[i]);
+    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(d, axis, len);
     const double ri = w->rad[i], rj = w->rad[j], rsum = ri + rj;
     const double dist2 = dem_v3_norm2(d);
     if (dist2 >= rsum * rsum) {
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
-        w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
+        if (!direct) w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
         if (w->def.implicit_damping) w->pair_g[k] = 0.0;
         if (w->imp.on) w->imp.pair[k] = (dem_imp_contact){{0, 0, 0}, 0, 0, 0, 0, 0, 0};
         return;
@@ -126,7 +156,6 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
     s.dt = w->hist_dt;
     dem_contact_out out;
     dem_contact_eval(&w->gg, &s, hist, &out, mask);
-    w->pair_f[k] = out.force;
     if (w->def.implicit_damping) { // read only by gather_damping
         w->pair_g[k] = out.damping_coeff;
         w->pair_n[k] = n;
@@ -137,16 +166,34 @@ static inline void pair_force(dem_world *restrict w, size_t i, size_t k, const u
     // Eq. 9–10: torques on i and on j.
     const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
     const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
-    w->pair_ti[k] = dem_v3_sub(dem_v3_scale(ts, ai), tr);
-    w->pair_tj[k] = dem_v3_add(dem_v3_scale(ts, aj), tr);
+    const dem_vec3 ti = dem_v3_sub(dem_v3_scale(ts, ai), tr), tj = dem_v3_add(dem_v3_scale(ts, aj), tr);
+    if (direct) {
+        w->frc[i] = dem_v3_add(w->frc[i], out.force);
+        w->frc[j] = dem_v3_sub(w->frc[j], out.force); // Newton's third law
+        w->trq[i] = dem_v3_add(w->trq[i], ti);
+        w->trq[j] = dem_v3_add(w->trq[j], tj);
+    } else {
+        w->pair_f[k] = out.force;
+        w->pair_ti[k] = ti;
+        w->pair_tj[k] = tj;
+    }
 }
 
-static inline void pair_loop(dem_world *restrict w, const unsigned mask)
+static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+    const int axis = w->def.periodic_axis;
+    const double len = axis < 0 ? 0.0 : dem_v3_comp(w->def.domain_hi, axis) - dem_v3_comp(w->def.domain_lo, axis);
+    if (!dem_forces_threaded(w)) {
+        memset(w->frc, 0, n * sizeof *w->frc);
+        memset(w->trq, 0, n * sizeof *w->trq);
+        for (size_t i = 0; i < n; ++i)
+            for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
+        return;
+    }
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; ++i)
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask);
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_SLOTS, axis, len);
 }
 
 // Accumulate γ n nᵀ into a symmetric 3×3 stored as xx yy zz xy xz yz.
@@ -156,7 +203,7 @@ static inline void add_damping(double *d, double g, dem_vec3 n)
     d[3] += g * n.x * n.y, d[4] += g * n.x * n.z, d[5] += g * n.y * n.z;
 }
 
-static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_t i, const unsigned mask)
+static DEM_ALWAYS_INLINE void wall_force(dem_world *restrict w, const dem_wall *wall, size_t i, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
     double *hist = wall->hist + i * (size_t)hl;
@@ -191,11 +238,13 @@ static inline void wall_force(dem_world *restrict w, const dem_wall *wall, size_
     w->trq[i] = dem_v3_add(w->trq[i], dem_v3_sub(ts, tr));
 }
 
-static inline void wall_loop(dem_world *restrict w, const dem_wall *wall, const unsigned mask)
+// Only the granules near the wall (dem_wall.near): the others are out of reach.
+static DEM_ALWAYS_INLINE void wall_loop(dem_world *restrict w, const dem_wall *wall, const unsigned mask)
 {
-    const size_t n = w->n;
+    const size_t n = wall->near_count;
+    const uint32_t *near = wall->near;
 #pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
-    for (size_t i = 0; i < n; ++i) wall_force(w, wall, i, mask);
+    for (size_t k = 0; k < n; ++k) wall_force(w, wall, near[k], mask);
 }
 
 // One specialised function per feature mask; the switch picks it per scene.
@@ -229,24 +278,25 @@ static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = {
 static const wall_loop_fn wall_loops[8] = {wall_loop_0, wall_loop_1, wall_loop_2, wall_loop_3,
                                            wall_loop_4, wall_loop_5, wall_loop_6, wall_loop_7};
 
+// Sum the per-pair slots of the threaded pair loop per granule, in the order
+// the direct loop adds them (as partner first, then its own row).
 static void gather(dem_world *restrict w)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; ++i) {
         dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
-            f = dem_v3_add(f, w->pair_f[k]);
-            t = dem_v3_add(t, w->pair_ti[k]);
-        }
         for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1]; ++r) {
             size_t k = w->rev_pair[r];
             f = dem_v3_sub(f, w->pair_f[k]); // Newton's third law
             t = dem_v3_add(t, w->pair_tj[k]);
         }
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
+            f = dem_v3_add(f, w->pair_f[k]);
+            t = dem_v3_add(t, w->pair_ti[k]);
+        }
         w->frc[i] = f;
         w->trq[i] = t;
-        if (w->imp.on) memset(w->imp.wall + 36 * i, 0, 36 * sizeof(double)); // the wall loops add to it
     }
 }
 
@@ -268,7 +318,8 @@ void dem_forces_compute(dem_world *w)
 {
     w->imp.on = w->def.implicit_springs && dem_imp_reserve(w) == 0;
     pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w);
-    gather(w);
+    if (dem_forces_threaded(w)) gather(w);
+    if (w->imp.on) memset(w->imp.wall, 0, 36 * w->n * sizeof *w->imp.wall); // the wall loops add to it
     if (w->def.implicit_damping) gather_damping(w);
     for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & 7u](w, &w->walls[k]);
 }

@@ -223,6 +223,37 @@ static void swap_lists(dem_world *w)
     w->nl.hist_len = dem_history_len(w->features); // the old list keeps its own layout
 }
 
+// A granule is near a wall if a sphere one skin larger would touch it (for a
+// disc, one skin wider too: a granule may slide in over its rim). The others
+// cannot reach the wall before the next rebuild; their springs are open, and
+// are cleared here so the wall loop need not visit them.
+static int build_wall_list(dem_world *w, dem_wall *wall)
+{
+    dem_wall_def grown = wall->def;
+    if (grown.kind == DEM_WALL_DISC) grown.radius += w->skin;
+    if (wall->near_cap < w->n) {
+        uint32_t *p = realloc(wall->near, (w->n ? w->n : 1) * sizeof *p);
+        if (!p) return 1;
+        wall->near = p;
+        wall->near_cap = w->n;
+    }
+    const size_t hl = (size_t)wall->hist_len;
+    size_t count = 0;
+    for (size_t i = 0; i < w->n; ++i) {
+        if (dem_wall_geometry(&grown, w->pos[i], w->rad[i] + w->skin).overlap > 0.0) wall->near[count++] = (uint32_t)i;
+        else if (hl) memset(wall->hist + i * hl, 0, hl * sizeof(double));
+    }
+    wall->near_count = count;
+    return 0;
+}
+
+static int build_wall_lists(dem_world *w)
+{
+    for (int k = 0; k < w->n_walls; ++k)
+        if (build_wall_list(w, &w->walls[k])) return 1;
+    return 0;
+}
+
 int dem_nl_rebuild(dem_world *w)
 {
     size_t n = w->n;
@@ -258,6 +289,8 @@ int dem_nl_rebuild(dem_world *w)
     }
     free(g.head);
     free(g.order);
+    if (fail) return dem_world_set_error(w, "out of memory building the neighbour list");
+    if (!fail) fail = build_wall_lists(w);
     if (fail) return dem_world_set_error(w, "out of memory building the neighbour list");
     memcpy(w->pos_at_build, w->pos, n * sizeof *w->pos);
     w->list_valid = 1;

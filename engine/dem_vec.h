@@ -10,6 +10,14 @@
 /// π (DEM_PI is not in strict C11).
 #define DEM_PI 3.14159265358979323846
 
+/// Force inlining of a hot kernel that the compiler's size heuristics would
+/// otherwise leave as a call (the contact law inside the pair loop).
+#if defined(__GNUC__) || defined(__clang__)
+#define DEM_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define DEM_ALWAYS_INLINE inline
+#endif
+
 /// A 3-vector of doubles; plain struct so arrays of it are dense (24 bytes).
 typedef struct dem_vec3 {
     double x, y, z;
@@ -27,6 +35,8 @@ static inline dem_vec3 dem_v3_cross(dem_vec3 a, dem_vec3 b)
 {
     return dem_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
+/// Component a (0 x, 1 y, 2 z).
+static inline double dem_v3_comp(dem_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
 static inline dem_vec3 dem_v3_neg(dem_vec3 a) { return dem_v3(-a.x, -a.y, -a.z); }
 static inline int dem_v3_isfinite(dem_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 

@@ -98,7 +98,7 @@ void dem_world_destroy(dem_world *w)
                       w->pair_n, w->pair_g, w->damp, w->acc,
                       w->pos_at_build};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) free(arrays[k]);
-    for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist);
+    for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist), free(w->walls[k].near);
     dem_nl_free(&w->nl);
     dem_nl_free(&w->nl_old);
     dem_imp_scratch_free(&w->imp);
@@ -141,6 +141,7 @@ dem_world *dem_world_clone(const dem_world *w)
         c->walls[k].def.name = c->walls[k].name;
         size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
         c->walls[k].hist = dup_bytes(w->walls[k].hist, (cap ? cap : 1) * hl * sizeof(double), &fail);
+        c->walls[k].near = dup_bytes(w->walls[k].near, w->walls[k].near_cap * sizeof *w->walls[k].near, &fail);
     }
     clone_list(&c->nl, &w->nl, &fail);
     clone_list(&c->nl_old, &w->nl_old, &fail);
@@ -226,9 +227,11 @@ static int wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_para
         return dem_world_set_error(w, "wall '%s' contact: %s", wall->name, sub);
     wall->def.contact = *p;
     wall->coeffs = dem_contact_coeffs_make(p);
+    const unsigned old = wall->features, springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
     wall->features = dem_contact_features(p);
     int hl = dem_history_len(wall->features);
-    if (hl != wall->hist_len || !wall->hist) {
+    // New layout (also tangential-only to rolling-only, same length): springs restart.
+    if (hl != wall->hist_len || !wall->hist || (old & springs) != (wall->features & springs)) {
         size_t cap = w->cap ? w->cap : 1;
         double *h = realloc(wall->hist, cap * (size_t)(hl ? hl : 1) * sizeof *h);
         if (!h) return dem_world_set_error(w, "out of memory for wall history");
@@ -282,7 +285,9 @@ int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)
     unsigned old = w->features;
     w->def.granule = *p;
     refresh_features(w);
-    if (dem_history_len(old) != dem_history_len(w->features)) w->list_valid = 0; // history layout changed
+    // History layout changed (a tangential spring must not be read as a rolling one): springs restart.
+    const unsigned springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
+    if ((old & springs) != (w->features & springs)) w->list_valid = 0;
     w->forces_valid = 0;
     w->prepared = 0;
     return 0;
@@ -495,7 +500,7 @@ static int refresh_list(dem_world *w)
 {
     double half_skin = 0.5 * w->skin;
     if (w->list_valid && dem_nl_max_displacement2(w) <= half_skin * half_skin) return 0;
-    return dem_nl_rebuild(w);
+    return dem_nl_rebuild(w); // also the walls' near lists (a wall added since unprepares the world)
 }
 
 static dem_status fault(dem_world *w, dem_status code, size_t i, const char *what)

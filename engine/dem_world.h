@@ -115,6 +115,8 @@ typedef struct dem_diagnostics {
     uint64_t step;
     size_t granules;
     size_t contacts;           ///< granule–granule contacts (overlap > 0)
+    size_t list_pairs;         ///< pairs the force loop visits: contacts + near misses within the skin
+    uint64_t list_rebuilds;    ///< neighbour-list rebuilds so far
     size_t wall_contacts;      ///< granule–wall contacts
     double coordination;       ///< mean granule–granule contacts per granule, 2·contacts/N
     double coordination_walls; ///< mean (granule + wall) contacts per granule
@@ -164,6 +166,13 @@ dem_status dem_world_step(dem_world *w, uint64_t steps);
 /// Remove granules for which keep(view index) is 0 (e.g. cutting a bed).
 void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx),
                                void *ctx);
+
+/// Re-order the granules along a space-filling (Morton) curve so that granules
+/// in contact sit close in memory: the force loop then reads its partners from
+/// cache at any N. Contact history, forces and ids are kept; view indices
+/// change. Call it once a bed is built (and now and then in a long run whose
+/// granules travel), never between reading a view and using its indices.
+dem_status dem_world_sort_spatially(dem_world *w);
 
 /// Set a granule's velocity and spin (by view index).
 void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega);

@@ -31,6 +31,11 @@ typedef struct dem_wall {
     unsigned features;
     int hist_len;
     double *hist; // hist_len doubles per granule
+    // Granules within one skin of this wall at the last list rebuild, in
+    // ascending order: the only ones that can touch it before the next (walls
+    // never move, and no granule moves half a skin between rebuilds).
+    uint32_t *near;
+    size_t near_count, near_cap;
 } dem_wall;
 
 // One contact as the implicit spring solve sees it (dem_forces.c): normal,

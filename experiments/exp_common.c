@@ -13,6 +13,10 @@
 
 const char *exp_version(void) { return DEM_VERSION; }
 
+#define EXP_STR(x) #x
+#define EXP_XSTR(x) EXP_STR(x)
+const char *exp_results_version(void) { return DEM_VERSION "/r" EXP_XSTR(EXP_RESULTS_VERSION); }
+
 int exp_fail(char *err, size_t len, const char *fmt, ...)
 {
     va_list ap;

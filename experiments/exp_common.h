@@ -6,8 +6,17 @@
 
 #include <stddef.h>
 
-/// Version string of the experiments layer (part of every result hash).
+/// Version string of the program (--version, report headers).
 const char *exp_version(void);
+
+/// Version of what a simulation returns: bumped by every change that alters
+/// a result for the same input (contact law, step choice, fill, even the order
+/// forces are summed in). Every stored record's key carries it, so a store
+/// written by an older engine is never served as this one's results.
+/// 2: forces added directly on one thread, wall near-lists, beds sorted along
+///    a Morton curve after the fill (summation order).
+#define EXP_RESULTS_VERSION 2
+const char *exp_results_version(void);
 
 /// Progress callback of long phases: phase name, simulated time, granules.
 typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);

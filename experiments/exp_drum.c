@@ -178,6 +178,9 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     }
     free(diam);
     cut_to_fill(w, d);
+    // Layers were poured in placement order; in curve order the force loop
+    // finds each granule's partners in cache for the rest of the run.
+    if (dem_world_sort_spatially(w) != DEM_OK) return fill_failed(w, NULL, err, len, dem_world_error(w));
     // At rest means far below the kinetic energy the drum will give the bed:
     // turning rigidly at 4 rpm (the slowest lab speed, wall speed v = 21 mm/s)
     // it has v^2 / (2 g d50) >= 3.5e-3 of (bed mass)·g·d50 for any d50 up to the

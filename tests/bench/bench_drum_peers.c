@@ -10,10 +10,12 @@
 //       sphere/granular: id type diameter density x y z), the peers' contact
 //       coefficients (OUTDIR/drum_N.liggghts.coeffs, OUTDIR/drum_N.lammps.coeffs)
 //       and OUTDIR/drum_N.vars (shell: λ, depth, dt_crit, granucal's steps).
+//   bench_drum_peers tile DATA OUTDIR TILES...
+//       The bed of DATA repeated TILES times along the axis, written like build.
 //   bench_drum_peers run DATA STEPS THREADS VARIANT DT [RPM [allow]]   (DT 0: the engine's network step)
 //       Reads DATA, builds the drum at the real parameters (VARIANT: all,
-//       norolling, notangential; morton: all, granules added in Morton
-//       order), turns it at RPM (40) and times STEPS steps
+//       norolling, notangential: granules sorted by dem_world_sort_spatially;
+//       unsorted: all, in the file's order), turns it at RPM (40) and times STEPS steps
 //       of DT s on THREADS OpenMP threads; prints one CSV line (see HEADER)
 //       with the angle and CSA before and after (the accuracy guard) and a
 //       checksum of the final positions (bitwise equal for 1 and 2 threads).
@@ -207,37 +209,14 @@ static int write_data(const char *path, const dem_world *w, const scene *s, cons
     return fclose(f);
 }
 
-// Reads a data file written above into a new world; returns NULL on error.
 typedef struct atom_rec {
-    uint64_t key;
     double d, rho, x, y, z;
 } atom_rec;
 
-static int cmp_key(const void *a, const void *b)
-{
-    uint64_t x = ((const atom_rec *)a)->key, y = ((const atom_rec *)b)->key;
-    return (x > y) - (x < y);
-}
-
-// Spreads the low 21 bits of v to every third bit (Morton interleave).
-static uint64_t spread3(uint64_t v)
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-}
-
-// Reads a data file written above into a new world; returns NULL on error.
-// morton: add the granules in Morton (Z-curve) order of their positions
-// instead of the file's order (the file holds them in placement order,
-// random in space) -- the reordering lever, measured without touching the
-// engine (LIGGGHTS and LAMMPS sort their atoms spatially themselves).
+// Reads a data file written above into a new world, granules in the file's
+// order (placement order, random in space); returns NULL on error.
 static dem_world *read_data(const char *path, scene *s, double dt, int threads, const dem_contact_params *gg,
-                            int allow, int morton)
+                            int allow)
 {
     FILE *f = fopen(path, "r");
     if (!f) return fprintf(stderr, "cannot open %s\n", path), NULL;
@@ -264,15 +243,10 @@ static dem_world *read_data(const char *path, scene *s, double dt, int threads, 
             a = b, cap *= 2;
             if (!a) break;
         }
-        const double span = 2.4 * DRUM_R, q = (double)(1u << 21) - 1;
-        r.key = spread3((uint64_t)((r.x + 1.2 * DRUM_R) / span * q)) |
-                spread3((uint64_t)((r.y + 1.2 * DRUM_R) / span * q)) << 1 |
-                spread3((uint64_t)(r.z / depth * q)) << 2;
         a[n++] = r;
     }
     fclose(f);
     if (!a) return fprintf(stderr, "out of memory\n"), NULL;
-    if (morton) qsort(a, n, sizeof *a, cmp_key);
     dem_contact_params p = gg ? *gg : s->gg;
     dem_world *w = create_world(s, &p, &s->gw, dt, threads, 0, allow);
     for (size_t i = 0; i < n; ++i)
@@ -382,7 +356,7 @@ static int emit(dem_world *w, const scene *sp, const char *outdir, double t0)
 
     // Granucal's own steps on the data as read back (explicit dashpot, the default).
     scene s2;
-    dem_world *r = read_data(path, &s2, 0, 2, NULL, 0, 0);
+    dem_world *r = read_data(path, &s2, 0, 2, NULL, 0);
     if (!r || dem_world_prepare(r) != DEM_OK) return fprintf(stderr, "read back failed\n"), 1;
     double dt_apriori = dem_world_dt(r), dt_crit = sqrt(dem_world_min_mass(r) / s.gg.k_n);
     char rep_apriori[1024], rep_net[1024];
@@ -496,6 +470,25 @@ static int cmd_build(int n, const char *outdir, int ntiles, char **tiles)
     return rc;
 }
 
+// Tiles of an existing bed's data file (the same settled slab, so a larger N
+// is added without settling the base again).
+static int cmd_tile(const char *data, const char *outdir, int ntiles, char **tiles)
+{
+    double t0 = now();
+    scene s;
+    dem_world *w = read_data(data, &s, 0, 2, NULL, 0);
+    if (!w) return 1;
+    int rc = 0;
+    for (int k = 0; k < ntiles && rc == 0; ++k) {
+        scene st;
+        dem_world *big = tile_bed(w, &s, atoi(tiles[k]), &st);
+        rc = emit(big, &st, outdir, t0);
+        dem_world_destroy(big);
+    }
+    dem_world_destroy(w);
+    return rc;
+}
+
 // ---------------------------------------------------------------- run
 
 static double checksum(const dem_world *w)
@@ -515,14 +508,16 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
     if (!probe) return fprintf(stderr, "cannot open %s\n", data), 1;
     fclose(probe);
     // First read with the scene's own contact, then apply the variant.
-    const int morton = strcmp(variant, "morton") == 0;
-    dem_world *w = read_data(data, &s, dt, threads, NULL, allow, morton);
+    const int unsorted = strcmp(variant, "unsorted") == 0;
+    dem_world *w = read_data(data, &s, dt, threads, NULL, allow);
     if (!w) return 1;
     p = s.gg;
     if (strcmp(variant, "norolling") == 0) p.mu_r = 0;
     else if (strcmp(variant, "notangential") == 0) p.mu_s = 0;
-    else if (strcmp(variant, "all") != 0 && !morton)
-        return fprintf(stderr, "variant: all, norolling, notangential or morton\n"), 1;
+    else if (strcmp(variant, "all") != 0 && !unsorted)
+        return fprintf(stderr, "variant: all, norolling, notangential or unsorted\n"), 1;
+    // As exp_drum does with a settled bed; `unsorted` keeps the file's order.
+    if (!unsorted && dem_world_sort_spatially(w) != DEM_OK) return fprintf(stderr, "%s\n", dem_world_error(w)), 1;
     dem_world_set_granule_contact(w, &p);
     // DT 0: the step the engine picks for this settled bed (its network step,
     // as exp_drum_rotate turns a drum).
@@ -535,11 +530,14 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
     measure(w, &s, &m0);
     double ke0 = exp_ke_ratio(w, d50);
     dem_world_set_wall_spin(w, 0, rpm * 2 * DEM_PI / 60);
+    st = dem_world_step(w, 0); // the first force evaluation (and list) outside the timing
     double t0 = now();
-    st = dem_world_step(w, (uint64_t)steps);
+    if (st == DEM_OK) st = dem_world_step(w, (uint64_t)steps);
     double loop = now() - t0;
     measure(w, &s, &m1);
     dem_diagnostics dg = dem_world_diagnose(w);
+    fprintf(stderr, "list: %.2f pairs per granule (%.2f in contact), %llu rebuilds\n", (double)dg.list_pairs / (double)n,
+            (double)dg.contacts / (double)n, (unsigned long long)dg.list_rebuilds);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     printf("granucal,%zu,%d,%s,%ld,%.6g,%.4f,%.5g,%ld,%.2f,%.2f,%.2f,%.2f,%.3g,%.3g,%.3f,%a,%s\n", n, threads, variant,
@@ -553,12 +551,13 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
 int main(int argc, char **argv)
 {
     if (argc >= 4 && strcmp(argv[1], "build") == 0) return cmd_build(atoi(argv[2]), argv[3], argc - 4, argv + 4);
+    if (argc >= 5 && strcmp(argv[1], "tile") == 0) return cmd_tile(argv[2], argv[3], argc - 4, argv + 4);
     if (argc >= 7 && strcmp(argv[1], "run") == 0)
         return cmd_run(argv[2], atol(argv[3]), atoi(argv[4]), argv[5], atof(argv[6]), argc > 7 ? atof(argv[7]) : 40,
                        argc > 8 && strcmp(argv[8], "allow") == 0);
     if (argc >= 2 && strcmp(argv[1], "header") == 0) return puts(HEADER), 0;
     fprintf(stderr,
-            "usage: %s build N OUTDIR [TILES...] | run DATA STEPS THREADS all|norolling|notangential|morton DT [RPM [allow]] | header\n",
+            "usage: %s build N OUTDIR [TILES...] | tile DATA OUTDIR TILES... | run DATA STEPS THREADS all|norolling|notangential|unsorted DT [RPM [allow]] | header\n",
             argv[0]);
     return 2;
 }

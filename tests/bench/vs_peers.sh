@@ -15,7 +15,8 @@
 #   --worktree build granucal from the work tree as it is (default: HEAD)
 #   --levers  only the reordering lever: granucal with the granules in the data
 #             file's order (placement order, random in space) against the same
-#             granules added in Morton order, 1 thread, all N (levers.csv)
+#             granules sorted by dem_world_sort_spatially (Morton order, what every
+#             other run does), 1 thread, all N (levers.csv)
 #
 # Order: for each N and thread count, granucal, LIGGGHTS, LAMMPS, repeated R
 # times (A B C A B C ...), so the shared machine's noise hits all three alike;
@@ -86,7 +87,7 @@ if [ $REBUILD -eq 1 ] || [ ! -f "$BEDS/drum_5000.vars" ] || [ ! -f "$BEDS/drum_1
 fi
 if [ $QUICK -eq 1 ]; then SIZES="5000 20000"; else SIZES="5000 20000 100000"; fi
 steps_for() { # ~5e6 particle-steps per run (x --scale)
-  case $1 in 5000) s=1000 ;; 20000) s=250 ;; *) s=60 ;; esac
+  case $1 in 5000) s=1000 ;; 20000) s=250 ;; 100000) s=60 ;; *) s=$((5000000 / $1)) ;; esac
   [ $QUICK -eq 1 ] && s=$((s / 2))
   python3 -c "print(max(10, int($s * $SCALE)))"
 }
@@ -147,7 +148,7 @@ if [ $LEVERS -eq 1 ]; then
     for rep in $(seq 1 "$REPS"); do
       echo "levers: N=$n rep $rep/$REPS" >&2
       run_granucal "$n" 1 "$rep" all "$(steps_for "$n")" "$DT_G"
-      run_granucal "$n" 1 "$rep" morton "$(steps_for "$n")" "$DT_G"
+      run_granucal "$n" 1 "$rep" unsorted "$(steps_for "$n")" "$DT_G"
     done
   done
   python3 - "$RAW" <<'EOF'
@@ -156,8 +157,8 @@ rows = [r for r in csv.DictReader(open(sys.argv[1])) if r['status'] == 'ok']
 print("granucal, 1 thread: particle-steps/s with the granules in file order and in Morton order (medians)")
 print("%7s %16s %16s %8s" % ("N", "file order", "Morton order", "speedup"))
 for n in sorted({int(r['N']) for r in rows}):
-    a = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'all'}
-    m = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'morton'}
+    a = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'unsorted'}
+    m = {r['rep']: float(r['psps']) for r in rows if r['N'] == str(n) and r['variant'] == 'all'}
     print("%7d %16.3e %16.3e %8.2f" % (n, st.median(a.values()), st.median(m.values()),
                                        st.median([m[k] / a[k] for k in a if k in m])))
 EOF
@@ -226,6 +227,22 @@ for rep in $(seq 1 "$REPS"); do
   sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,all_passive_wait,/' "$RAW"
 done
 
+# ---- cost per particle-step against N (granucal, 1 thread), up to 10^6
+# granules: the 5 000 slab tiled 200 times (1.8 m of periodic slice). Sizes
+# alternate within each repetition so the machine's noise hits all alike.
+FLAT_SIZES="5000 20000 100000"
+if [ $QUICK -eq 0 ]; then
+  FLAT_SIZES="$FLAT_SIZES 1000000"
+  [ -f "$BEDS/drum_1000000.vars" ] || "$BENCH" tile "$BEDS/drum_5000.data" "$BEDS" 200 2>> "$OUT/build_beds.log"
+fi
+for rep in $(seq 1 "$REPS"); do
+  for n in $FLAT_SIZES; do
+    echo "flatness: N=$n rep $rep/$REPS" >&2
+    run_granucal "$n" 1 "$rep" all "$(python3 -c "print(max(10, $(steps_for "$n")))")" "$DT"
+    sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,flat,/' "$RAW"
+  done
+done
+
 # ---- 3. table, 1 s of drum, accuracy guard, final line
 python3 - "$RAW" "$BEDS" "$DTC" "$DT_NET" "$BEDMASS" "$D50" <<'EOF'
 import csv, statistics as st, sys
@@ -281,6 +298,16 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit()}):
                 sp = med([num(r['psps']) / al[r['rep']] for r in rs if r['rep'] in al])
                 print("granucal %-14s N=%d thr=%s: %.3e p-steps/s, %.2fx all effects on" % (
                     v, n, th, med([num(r['psps']) for r in rs]), sp))
+
+print("\n== cost per particle-step against N (granucal, 1 thread, medians; memory is the process's peak RSS)")
+flat = {}
+for n in sorted({int(r['N']) for r in rows if r['variant'] == 'flat'}):
+    rs = [r for r in rows if r['variant'] == 'flat' and r['N'] == str(n) and r['status'] == 'ok']
+    if rs: flat[n] = (med([1e6 / num(r['psps']) for r in rs]), med([num(r['maxrss_kib']) for r in rs]))
+base = flat.get(min(flat)) if flat else None
+for n, (us, kib) in sorted(flat.items()):
+    print("  N=%8d: %.3f us per particle-step (%.2fx N=%d), peak memory %.1f MiB = %.2f KiB per granule" % (
+        n, us, us / base[0], min(flat), kib / 1024, kib / n))
 
 print("\n== wall time to simulate 1 s of the drum at N = 20000, at each code's largest step kept at rest")
 for th in ('1', '2'):
