@@ -453,21 +453,28 @@ static dem_world *tile_bed(const dem_world *base, const scene *sb, int tiles, sc
     return w;
 }
 
+// Writes the bed repeated by each count in `tiles`; consumes `w`.
+static int emit_tiles(dem_world *w, const scene *s, const char *outdir, int ntiles, char **tiles, double t0)
+{
+    int rc = 0;
+    for (int k = 0; k < ntiles && rc == 0; ++k) {
+        scene st;
+        dem_world *big = tile_bed(w, s, atoi(tiles[k]), &st);
+        rc = emit(big, &st, outdir, t0);
+        dem_world_destroy(big);
+    }
+    dem_world_destroy(w);
+    return rc;
+}
+
 static int cmd_build(int n, const char *outdir, int ntiles, char **tiles)
 {
     double t0 = now();
     scene s;
     dem_world *w = build_base(n, &s);
     if (!w) return 1;
-    int rc = emit(w, &s, outdir, t0);
-    for (int k = 0; k < ntiles && rc == 0; ++k) {
-        scene st;
-        dem_world *big = tile_bed(w, &s, atoi(tiles[k]), &st);
-        rc = emit(big, &st, outdir, t0);
-        dem_world_destroy(big);
-    }
-    dem_world_destroy(w);
-    return rc;
+    if (emit(w, &s, outdir, t0)) return dem_world_destroy(w), 1;
+    return emit_tiles(w, &s, outdir, ntiles, tiles, t0);
 }
 
 // Tiles of an existing bed's data file (the same settled slab, so a larger N
@@ -478,15 +485,7 @@ static int cmd_tile(const char *data, const char *outdir, int ntiles, char **til
     scene s;
     dem_world *w = read_data(data, &s, 0, 2, NULL, 0);
     if (!w) return 1;
-    int rc = 0;
-    for (int k = 0; k < ntiles && rc == 0; ++k) {
-        scene st;
-        dem_world *big = tile_bed(w, &s, atoi(tiles[k]), &st);
-        rc = emit(big, &st, outdir, t0);
-        dem_world_destroy(big);
-    }
-    dem_world_destroy(w);
-    return rc;
+    return emit_tiles(w, &s, outdir, ntiles, tiles, t0);
 }
 
 // ---------------------------------------------------------------- run

@@ -271,7 +271,7 @@ print("\n== timing (medians of %s repetitions; ratio = granucal/peer, formed per
 print("%-9s %7s %3s %6s %14s %9s %10s %14s %14s" % ("code", "N", "thr", "steps", "p-steps/s", "wall s", "peak MiB",
                                                     "vs liggghts", "vs lammps"))
 summary = {}
-for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit()}):
+for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'] == 'all'}):
     for th in ('1', '2'):
         g = {r['rep']: r for r in sel(N=str(n), threads=th, code='granucal', variant='all') if r['rep'].isdigit()}
         for code in ('granucal', 'liggghts', 'lammps'):
