@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// Force and torque evaluation. Each granule–granule pair writes its force and
-// two torques into per-pair slots; each granule then gathers its own pairs in
-// ascending pair order. No two threads write the same memory, and the sum
-// order is fixed, so results are bitwise identical for any thread count.
+// Force and torque evaluation. Each granule–granule pair adds its force and
+// two torques to both granules, rows in ascending order; with threads, each
+// owns a block of granules and only the pairs that cross a block's edge go
+// through per-pair slots (pair_loop_threaded). No two threads write the same
+// memory, and every granule sums its terms in the serial order, so results
+// are bitwise identical for any thread count.
 //
 // The pair loop and the wall loop are instantiated once per feature mask
 // (DEM_FEATURE_LOOP below): with the mask a constant, the inline kernel of
@@ -54,8 +56,7 @@ static inline void dem_imp_add_block(double *b, dem_vec3 n, double g, double kt,
         }
 }
 
-// Whether the pair loop runs on several threads (per-pair slots and a
-// gather) or on one (forces added directly).
+// Whether the pair loop runs on several threads (blocks of granules) or on one.
 static inline int dem_forces_threaded(const dem_world *w)
 {
     return w->n >= DEM_OMP_MIN_GRANULES && omp_get_max_threads() > 1;
@@ -100,12 +101,9 @@ void dem_imp_scratch_free(dem_imp_scratch *s)
     memset(s, 0, sizeof *s);
 }
 
-// How a pair loop hands its forces on. DIRECT adds them straight to both
-// granules (one thread); SLOTS writes them into per-pair slots that gather()
-// sums per granule (several threads, no two writing the same memory). Both add
-// the same terms in the same order, so the results are bitwise identical:
-// granule j first receives its pairs as partner (rows i < j, ascending), then
-// its own row.
+// How a pair hands its forces on. DIRECT adds them straight to both granules;
+// SLOTS writes them into the pair's slots, for a pair crossing a thread's
+// block (pair_loop_threaded adds them in the serial order).
 enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
 
 // Minimum image along the periodic axis for a separation shorter than one
@@ -179,21 +177,74 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t
     }
 }
 
-static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
+// Granules [lo, hi) of thread t of nt: contiguous blocks, so with the
+// granules sorted along a space-filling curve few pairs cross a block's edge.
+static inline void thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
+{
+    *lo = n * (size_t)t / (size_t)nt;
+    *hi = n * (size_t)(t + 1) / (size_t)nt;
+}
+
+// The serial order, the reference every thread count reproduces bit for bit:
+// rows ascending, each pair added to i and to j as it comes.
+static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsigned mask, int axis, double len)
 {
     const size_t n = w->n;
+    memset(w->frc, 0, n * sizeof *w->frc);
+    memset(w->trq, 0, n * sizeof *w->trq);
+    for (size_t i = 0; i < n; ++i)
+        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
+}
+
+// Threads: each owns a block of granules and adds the pairs inside it
+// directly. A pair reaching past the block's end (rows are sorted by
+// partner, so these close each row) is computed first, into its slots; after
+// a barrier each thread starts its granules from the slots of pairs coming in
+// from lower blocks (the lowest pair indices, so first in the serial order),
+// then walks its rows as the serial loop does, taking the outgoing crossing
+// pairs' part from their slots at the end of each row. Every granule sums the
+// same terms in the same order as pair_loop_serial.
+static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask, int axis, double len)
+{
+    const size_t *start = w->nl.start;
+    const uint32_t *nbr = w->nl.j;
+#pragma omp parallel
+    {
+        size_t lo, hi;
+        thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
+        for (size_t i = lo; i < hi; ++i) // outgoing crossing pairs: into slots
+            for (size_t k = start[i + 1]; k > start[i] && nbr[k - 1] >= hi; --k)
+                pair_force(w, i, k - 1, mask, DEM_SLOTS, axis, len);
+#pragma omp barrier
+        const size_t first_own_pair = start[lo];
+        for (size_t i = lo; i < hi; ++i) { // incoming crossing pairs: partner rows below lo
+            dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
+            for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1] && w->rev_pair[r] < first_own_pair; ++r) {
+                const size_t k = w->rev_pair[r];
+                f = dem_v3_sub(f, w->pair_f[k]); // Newton's third law
+                t = dem_v3_add(t, w->pair_tj[k]);
+            }
+            w->frc[i] = f;
+            w->trq[i] = t;
+        }
+        for (size_t i = lo; i < hi; ++i)
+            for (size_t k = start[i]; k < start[i + 1]; ++k) {
+                if (nbr[k] < hi) {
+                    pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
+                } else {
+                    w->frc[i] = dem_v3_add(w->frc[i], w->pair_f[k]);
+                    w->trq[i] = dem_v3_add(w->trq[i], w->pair_ti[k]);
+                }
+            }
+    }
+}
+
+static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
+{
     const int axis = w->def.periodic_axis;
     const double len = axis < 0 ? 0.0 : dem_v3_comp(w->def.domain_hi, axis) - dem_v3_comp(w->def.domain_lo, axis);
-    if (!dem_forces_threaded(w)) {
-        memset(w->frc, 0, n * sizeof *w->frc);
-        memset(w->trq, 0, n * sizeof *w->trq);
-        for (size_t i = 0; i < n; ++i)
-            for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
-        return;
-    }
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; ++i)
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_SLOTS, axis, len);
+    if (dem_forces_threaded(w)) pair_loop_threaded(w, mask, axis, len);
+    else pair_loop_serial(w, mask, axis, len);
 }
 
 // Accumulate γ n nᵀ into a symmetric 3×3 stored as xx yy zz xy xz yz.
@@ -278,28 +329,6 @@ static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = {
 static const wall_loop_fn wall_loops[8] = {wall_loop_0, wall_loop_1, wall_loop_2, wall_loop_3,
                                            wall_loop_4, wall_loop_5, wall_loop_6, wall_loop_7};
 
-// Sum the per-pair slots of the threaded pair loop per granule, in the order
-// the direct loop adds them (as partner first, then its own row).
-static void gather(dem_world *restrict w)
-{
-    const size_t n = w->n;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; ++i) {
-        dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
-        for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1]; ++r) {
-            size_t k = w->rev_pair[r];
-            f = dem_v3_sub(f, w->pair_f[k]); // Newton's third law
-            t = dem_v3_add(t, w->pair_tj[k]);
-        }
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
-            f = dem_v3_add(f, w->pair_f[k]);
-            t = dem_v3_add(t, w->pair_ti[k]);
-        }
-        w->frc[i] = f;
-        w->trq[i] = t;
-    }
-}
-
 // Each granule's own dashpots, Σγ n nᵀ over its contacts (implicit dashpot).
 static void gather_damping(dem_world *restrict w)
 {
@@ -318,7 +347,6 @@ void dem_forces_compute(dem_world *w)
 {
     w->imp.on = w->def.implicit_springs && dem_imp_reserve(w) == 0;
     pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w);
-    if (dem_forces_threaded(w)) gather(w);
     if (w->imp.on) memset(w->imp.wall, 0, 36 * w->n * sizeof *w->imp.wall); // the wall loops add to it
     if (w->def.implicit_damping) gather_damping(w);
     for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & 7u](w, &w->walls[k]);

@@ -5,6 +5,8 @@
 //    where the tangential spring must change sign), and the next steps give
 //    bitwise the same forces for an isolated pair and rounding-level ones for
 //    a loaded bed; contact partners end up close in memory;
+//  - 1, 2 and 3 threads give the same bits (blocks of granules, crossing pairs
+//    through slots, every granule summing in the serial order);
 //  - the wall near-lists miss no contact: a granule thrown at a wall from
 //    afar, across several list rebuilds, bounces; a wall added to a running
 //    world acts at once;
@@ -20,6 +22,7 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <omp.h>
 
 #include "dem_world.h"
 
@@ -110,13 +113,13 @@ static dem_world *shuffled_bed(void)
     dem_wall_def floor = {.kind = DEM_WALL_PLANE, .point = {0, 0, 0}, .normal = {0, 1, 0}, .axis = {0, 1, 0},
                           .contact = def.granule, .name = "floor"};
     assert_true(dem_world_add_wall(w, &floor) >= 0);
-    for (int a = 0; a < 2; ++a) { // side walls at x = ±0.015
+    for (int a = 0; a < 2; ++a) { // side walls at ±7.5 mm: a column some 8 granules deep
         dem_wall_def side = floor;
-        side.point = dem_v3(a ? 0.015 : -0.015, 0, 0);
+        side.point = dem_v3(a ? 0.0075 : -0.0075, 0, 0);
         side.normal = dem_v3(a ? -1 : 1, 0, 0);
         side.name = a ? "right" : "left";
         assert_true(dem_world_add_wall(w, &side) >= 0);
-        side.point = dem_v3(0, 0, a ? 0.015 : -0.015);
+        side.point = dem_v3(0, 0, a ? 0.0075 : -0.0075);
         side.normal = dem_v3(0, 0, a ? -1 : 1);
         assert_true(dem_world_add_wall(w, &side) >= 0);
     }
@@ -130,12 +133,14 @@ static dem_world *shuffled_bed(void)
     }
     for (int s = 0; s < BED_N; ++s) {
         int i = order[s];
-        dem_vec3 p = dem_v3(0.0028 * (i % 10) - 0.0126, 0.0015 + 0.0028 * (i / 100), 0.0028 * ((i / 10) % 10) - 0.0126);
-        assert_true(dem_world_add_granule(w, p, dem_v3(0, 0, 0), dem_v3(0, 0, 0), 1e-3 * (1 + 0.25 * sin(1.7 * i)),
-                                          1800) >= 0);
+        dem_vec3 p = dem_v3(0.0028 * (i % 5) - 0.0056, 0.0015 + 0.0028 * (i / 25), 0.0028 * ((i / 5) % 5) - 0.0056);
+        // Lateral kicks so the stacked lattice collapses into a packing
+        // instead of standing as chains (coordination 2).
+        dem_vec3 v = dem_v3(0.05 * sin(1.7 * i), 0.0, 0.05 * cos(2.3 * i));
+        assert_true(dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 1e-3 * (1 + 0.25 * sin(1.7 * i)), 1800) >= 0);
     }
     assert_int_equal(dem_world_prepare(w), DEM_OK); // fixes the step
-    assert_int_equal(dem_world_step(w, (uint64_t)(0.08 / dem_world_dt(w))), DEM_OK);
+    assert_int_equal(dem_world_step(w, (uint64_t)(0.4 / dem_world_dt(w))), DEM_OK); // falls 6.5 cm, settles
     return w;
 }
 
@@ -199,6 +204,42 @@ static void test_sort_keeps_a_loaded_bed(void **state)
     assert_true(spread_after < 0.25 * spread_before);
     dem_world_destroy(a);
     dem_world_destroy(b);
+}
+
+// A copy of `bed` stepped on `threads` OpenMP threads.
+static dem_world *stepped_on(const dem_world *bed, int threads, uint64_t steps)
+{
+    dem_world *w = dem_world_clone(bed);
+    assert_non_null(w);
+    omp_set_num_threads(threads);
+    assert_int_equal(dem_world_step(w, steps), DEM_OK);
+    return w;
+}
+
+static void test_threads_sum_in_the_serial_order(void **state)
+{
+    (void)state;
+    // 600 granules: above DEM_OMP_MIN_GRANULES, so 2 and 3 threads split the
+    // rows into blocks, and pairs cross the blocks' edges.
+    // A deep column: most granules sum several forces, where a different
+    // order would change the last bits.
+    dem_world *bed = shuffled_bed();
+    assert_int_equal(dem_world_sort_spatially(bed), DEM_OK);
+    const int saved = omp_get_max_threads();
+    dem_world *one = stepped_on(bed, 1, 1000), *two = stepped_on(bed, 2, 1000), *three = stepped_on(bed, 3, 1000);
+    omp_set_num_threads(saved);
+    dem_granules_view a = dem_world_granules(one), b = dem_world_granules(two), c = dem_world_granules(three);
+    printf("sorted bed, %zu contacts, 1000 steps on 1, 2 and 3 threads: positions and spins %s\n",
+           dem_world_diagnose(one).contacts,
+           memcmp(a.position, b.position, a.count * sizeof *a.position) == 0 &&
+                   memcmp(a.position, c.position, a.count * sizeof *a.position) == 0
+               ? "bitwise identical"
+               : "DIFFERENT");
+    assert_memory_equal(a.position, b.position, a.count * sizeof *a.position);
+    assert_memory_equal(a.position, c.position, a.count * sizeof *a.position);
+    assert_memory_equal(a.omega, b.omega, a.count * sizeof *a.omega);
+    assert_memory_equal(a.omega, c.omega, a.count * sizeof *a.omega);
+    dem_world_destroy(one), dem_world_destroy(two), dem_world_destroy(three), dem_world_destroy(bed);
 }
 
 // ------------------------------------------------------- wall near-lists ---
@@ -298,6 +339,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sort_swaps_pair_roles_bitwise),
         cmocka_unit_test(test_sort_keeps_a_loaded_bed),
+        cmocka_unit_test(test_threads_sum_in_the_serial_order),
         cmocka_unit_test(test_wall_reached_across_rebuilds),
         cmocka_unit_test(test_wall_added_to_running_world),
         cmocka_unit_test(test_tangential_to_rolling_restarts_springs),
