@@ -83,8 +83,9 @@ struct dem_world {
     unsigned features; // granule–granule mask | DEM_FEAT_PERIODIC
 
     // Neighbour list, its double buffer for carrying history, per-pair
-    // outputs (force on i, torque on i, torque on j) and the reverse index
-    // (for each granule, the pairs in which it is j, ascending).
+    // outputs (force on i, torque on i, torque on j: written only for pairs
+    // crossing a thread's block, dem_forces.c) and the reverse index (for
+    // each granule, the pairs in which it is j, ascending).
     dem_neighbor_list nl, nl_old;
     dem_vec3 *pair_f, *pair_ti, *pair_tj;
     dem_vec3 *pair_n;  // contact normal, for the implicit dashpot
