@@ -106,14 +106,16 @@ void dem_imp_scratch_free(dem_imp_scratch *s)
 // block (pair_loop_threaded adds them in the serial order).
 enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
 
-// Minimum image along the periodic axis for a separation shorter than one
-// period (both centres are wrapped into the domain): one compare per pair
-// instead of a division and a rounding.
+// Minimum image along the periodic axis. Centres are wrapped into the domain
+// by every drift, so a separation is shorter than one period and one compare
+// does it; a granule placed outside the domain, before its first drift,
+// takes the general rounding.
 static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(dem_vec3 d, int axis, double len)
 {
     double *c = axis == 0 ? &d.x : axis == 1 ? &d.y : &d.z;
     if (*c > 0.5 * len) *c -= len;
     else if (*c < -0.5 * len) *c += len;
+    if (fabs(*c) > 0.5 * len) *c -= len * nearbyint(*c / len);
     return d;
 }
 

@@ -289,9 +289,7 @@ int dem_nl_rebuild(dem_world *w)
     }
     free(g.head);
     free(g.order);
-    if (fail) return dem_world_set_error(w, "out of memory building the neighbour list");
-    if (!fail) fail = build_wall_lists(w);
-    if (fail) return dem_world_set_error(w, "out of memory building the neighbour list");
+    if (fail || build_wall_lists(w)) return dem_world_set_error(w, "out of memory building the neighbour list");
     memcpy(w->pos_at_build, w->pos, n * sizeof *w->pos);
     w->list_valid = 1;
     w->rebuilds++;
