@@ -100,6 +100,15 @@ static inline int dem_history_len(unsigned features)
     return 3 * (((features & DEM_FEAT_TANGENTIAL) != 0) + ((features & DEM_FEAT_ROLLING) != 0));
 }
 
+/// Whether two feature masks store the same springs in their history: a
+/// tangential-only and a rolling-only contact both hold 3 doubles, and one
+/// must not be read as the other.
+static inline int dem_same_history_layout(unsigned a, unsigned b)
+{
+    const unsigned springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
+    return (a & springs) == (b & springs);
+}
+
 /// Derive kernel coefficients from parameters.
 dem_contact_coeffs dem_contact_coeffs_make(const dem_contact_params *p);
 

@@ -109,14 +109,14 @@ enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
 // Minimum image along the periodic axis. Centres are wrapped into the domain
 // by every drift, so a separation is shorter than one period and one compare
 // does it; a granule placed outside the domain, before its first drift,
-// takes the general rounding.
-static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(dem_vec3 d, int axis, double len)
+// takes the general dem_world_min_image.
+static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(const dem_world *w, dem_vec3 d, int axis, double len)
 {
-    double *c = axis == 0 ? &d.x : axis == 1 ? &d.y : &d.z;
+    dem_vec3 s = d;
+    double *c = axis == 0 ? &s.x : axis == 1 ? &s.y : &s.z;
     if (*c > 0.5 * len) *c -= len;
     else if (*c < -0.5 * len) *c += len;
-    if (fabs(*c) > 0.5 * len) *c -= len * nearbyint(*c / len);
-    return d;
+    return fabs(*c) <= 0.5 * len ? s : dem_world_min_image(w, d);
 }
 
 static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t k, const unsigned mask,
@@ -127,7 +127,7 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t
     double *restrict hist = w->nl.hist + k * (size_t)hl;
     const dem_vec3 *restrict pos = w->pos;
     dem_vec3 d = dem_v3_sub(pos[j], pos[i]);
-    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(d, axis, len);
+    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(w, d, axis, len);
     const double ri = w->rad[i], rj = w->rad[j], rsum = ri + rj;
     const double dist2 = dem_v3_norm2(d);
     if (dist2 >= rsum * rsum) {
@@ -244,7 +244,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
 static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
 {
     const int axis = w->def.periodic_axis;
-    const double len = axis < 0 ? 0.0 : dem_v3_comp(w->def.domain_hi, axis) - dem_v3_comp(w->def.domain_lo, axis);
+    const double len = dem_world_period(w);
     if (dem_forces_threaded(w)) pair_loop_threaded(w, mask, axis, len);
     else pair_loop_serial(w, mask, axis, len);
 }

@@ -19,13 +19,11 @@ typedef struct cell_grid {
     uint32_t *order;
 } cell_grid;
 
-static double comp(dem_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
-
 dem_vec3 dem_world_min_image(const dem_world *w, dem_vec3 d)
 {
     int a = w->def.periodic_axis;
     if (a < 0) return d;
-    double len = comp(w->def.domain_hi, a) - comp(w->def.domain_lo, a);
+    double len = dem_world_period(w);
     double *c = a == 0 ? &d.x : a == 1 ? &d.y : &d.z;
     *c -= len * nearbyint(*c / len);
     return d;
@@ -36,8 +34,8 @@ static void grid_dims(const dem_world *w, double cutoff, cell_grid *g)
     size_t budget = (w->n + 1) * MAX_CELLS_PER_GRANULE;
     double span[3];
     for (int a = 0; a < 3; ++a) {
-        g->lo[a] = comp(w->def.domain_lo, a);
-        span[a] = comp(w->def.domain_hi, a) - g->lo[a];
+        g->lo[a] = dem_v3_comp(w->def.domain_lo, a);
+        span[a] = dem_v3_comp(w->def.domain_hi, a) - g->lo[a];
     }
     double cs = cutoff;
     for (;;) {

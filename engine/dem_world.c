@@ -39,7 +39,6 @@ int dem_world_set_error(dem_world *w, const char *fmt, ...)
     return 1;
 }
 
-static double axis_comp(dem_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
 
 static int check_def(const dem_world_def *d, char *msg, size_t len)
 {
@@ -55,7 +54,7 @@ static int check_def(const dem_world_def *d, char *msg, size_t len)
     if (d->periodic_axis < -1 || d->periodic_axis > 2)
         return snprintf(msg, len, "periodic_axis = %d: must be -1, 0, 1 or 2", d->periodic_axis), 1;
     for (int a = 0; a < 3; ++a)
-        if (!(axis_comp(d->domain_hi, a) > axis_comp(d->domain_lo, a)))
+        if (!(dem_v3_comp(d->domain_hi, a) > dem_v3_comp(d->domain_lo, a)))
             return snprintf(msg, len, "domain: hi must exceed lo on axis %d", a), 1;
     return 0;
 }
@@ -227,11 +226,10 @@ static int wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_para
         return dem_world_set_error(w, "wall '%s' contact: %s", wall->name, sub);
     wall->def.contact = *p;
     wall->coeffs = dem_contact_coeffs_make(p);
-    const unsigned old = wall->features, springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
+    const unsigned old = wall->features;
     wall->features = dem_contact_features(p);
     int hl = dem_history_len(wall->features);
-    // New layout (also tangential-only to rolling-only, same length): springs restart.
-    if (hl != wall->hist_len || !wall->hist || (old & springs) != (wall->features & springs)) {
+    if (!wall->hist || !dem_same_history_layout(old, wall->features)) { // springs restart
         size_t cap = w->cap ? w->cap : 1;
         double *h = realloc(wall->hist, cap * (size_t)(hl ? hl : 1) * sizeof *h);
         if (!h) return dem_world_set_error(w, "out of memory for wall history");
@@ -285,9 +283,7 @@ int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)
     unsigned old = w->features;
     w->def.granule = *p;
     refresh_features(w);
-    // History layout changed (a tangential spring must not be read as a rolling one): springs restart.
-    const unsigned springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
-    if ((old & springs) != (w->features & springs)) w->list_valid = 0;
+    if (!dem_same_history_layout(old, w->features)) w->list_valid = 0; // springs restart
     w->forces_valid = 0;
     w->prepared = 0;
     return 0;
@@ -325,7 +321,7 @@ static int check_periodic_length(dem_world *w)
 {
     int a = w->def.periodic_axis;
     if (a < 0) return 0;
-    double len = axis_comp(w->def.domain_hi, a) - axis_comp(w->def.domain_lo, a);
+    double len = dem_world_period(w);
     // A pair must touch through one image only.
     double need = 2.0 * (2.0 * dem_world_max_radius(w) + w->skin);
     if (len <= need)
@@ -465,7 +461,7 @@ static size_t kick_drift(dem_world *restrict w, int *escaped)
         dem_vec3 p = dem_v3_axpy(dt, v, w->pos[i]);
         double *pc[3] = {&p.x, &p.y, &p.z};
         if (pa >= 0) { // wrap into [lo, hi) along the periodic axis
-            double l = axis_comp(lo, pa), len = axis_comp(hi, pa) - l;
+            double l = dem_v3_comp(lo, pa), len = dem_v3_comp(hi, pa) - l;
             *pc[pa] -= len * floor((*pc[pa] - l) / len);
         }
         w->pos[i] = p;

@@ -141,6 +141,13 @@ static inline dem_wall_touch dem_wall_geometry(const dem_wall_def *wd, dem_vec3 
     return t;
 }
 
+// Length of the domain along the periodic axis (0 if none).
+static inline double dem_world_period(const dem_world *w)
+{
+    const int a = w->def.periodic_axis;
+    return a < 0 ? 0.0 : dem_v3_comp(w->def.domain_hi, a) - dem_v3_comp(w->def.domain_lo, a);
+}
+
 // dem_neighbor.c
 int dem_nl_rebuild(dem_world *w);
 void dem_nl_free(dem_neighbor_list *nl);
