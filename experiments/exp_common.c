@@ -33,16 +33,28 @@ double exp_wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len)
+int exp_split_set(const char *set, char key[32], const char **value, char *err, size_t len)
 {
     const char *eq = strchr(set, '=');
     if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
     snprintf(key, 32, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
+    *value = eq + 1;
+    return 0;
+}
+
+int exp_parse_number(const char *text, double *out)
+{
     char *end;
     errno = 0;
-    *value = strtod(eq + 1, &end);
-    if (errno || end == eq + 1 || *end || !isfinite(*value))
-        return exp_fail(err, len, "--set %s: '%s' is not a number", key, eq + 1);
+    *out = strtod(text, &end);
+    return errno != 0 || end == text || *end != '\0' || !isfinite(*out);
+}
+
+int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len)
+{
+    const char *text = NULL;
+    if (exp_split_set(set, key, &text, err, len)) return 1;
+    if (exp_parse_number(text, value)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, text);
     return 0;
 }
 

@@ -28,8 +28,13 @@ int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(
 /// Seconds of wall-clock time (monotonic) since an arbitrary origin.
 double exp_wall_seconds(void);
 
-/// Split a `--set key=value` whose value must be a finite number: 0, else 1
-/// with a message naming the key.
+/// Split a `--set key=value` into its key and the text of its value (a
+/// pointer into `set`): 0, else 1 with a message.
+int exp_split_set(const char *set, char key[32], const char **value, char *err, size_t len);
+/// A finite number that fills the whole text: 0, else 1.
+int exp_parse_number(const char *text, double *out);
+/// exp_split_set for a value that must be a finite number: 0, else 1 with a
+/// message naming the key.
 int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len);
 
 /// Peak resident memory of this process so far, MiB (getrusage).

@@ -44,14 +44,6 @@ static const cyaml_schema_value_t drum_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_
 
 int exp_is_drum_config(const char *path) { return exp_yaml_starts_with(path, "experiment: drum"); }
 
-static int parse_number(const char *text, double *out)
-{
-    char *end;
-    errno = 0;
-    *out = strtod(text, &end);
-    return errno != 0 || end == text || *end != '\0' || !isfinite(*out);
-}
-
 static char *dup_string(const char *s)
 {
     char *d = malloc(strlen(s) + 1);
@@ -63,11 +55,9 @@ static char *dup_string(const char *s)
 // (plain malloc/free via cyaml_mem), so a replaced string is freed with free.
 static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
 {
-    const char *eq = strchr(set, '=');
-    if (!eq) return exp_fail(err, len, "--set %s: expected key=value", set);
     char key[32];
-    snprintf(key, sizeof key, "%.*s", (int)(eq - set < 31 ? eq - set : 31), set);
-    const char *value = eq + 1;
+    const char *value = NULL;
+    if (exp_split_set(set, key, &value, err, len)) return 1;
     if (strcmp(key, "wall") == 0) {
         char *copy = dup_string(value);
         if (!copy) return exp_fail(err, len, "out of memory");
@@ -81,12 +71,12 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
     double v;
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (strcmp(key, numbers[k].name) == 0) {
-            if (parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
+            if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
             *numbers[k].field = v;
             return 0;
         }
     if (strcmp(key, "seed") == 0) {
-        if (parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
+        if (exp_parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
             return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
         y->seed = (int)v;
         return 0;
