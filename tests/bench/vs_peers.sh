@@ -110,6 +110,12 @@ run_granucal() {
   echo "$line" | awk -F, -v rep="$rep" '{st=$18; gsub(/,/,";",st); printf "granucal,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n",$2,$3,rep,$4,$5,$6,$7,$8,$9,(st=="ok"?"ok":"fault"),$10,$11,$12,$13,$17,$15}' >> "$RAW"
 }
 
+# relabel_last VARIANT: the last granucal run (variant all) is a VARIANT run of
+# the same scene (another wait policy, the flatness pass), kept apart in RAW.
+relabel_last() {
+  sed -i "\$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,$1,/" "$RAW"
+}
+
 # run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO
 run_peer() {
   local code=$1 n=$2 np=$3 rep=$4 steps=$5 dt=$6 omega=$7 nthermo=$8
@@ -222,9 +228,9 @@ done
 echo "N=$N0 threads=2: granucal with the default OpenMP wait policy" >&2
 for rep in $(seq 1 "$REPS"); do
   GRANUCAL_WAIT="" run_granucal $N0 2 "$rep" all "$(steps_for $N0)" "$DT"
-  sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,all_default_wait,/' "$RAW"
+  relabel_last all_default_wait
   run_granucal $N0 2 "$rep" all "$(steps_for $N0)" "$DT"
-  sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,all_passive_wait,/' "$RAW"
+  relabel_last all_passive_wait
 done
 
 # ---- cost per particle-step against N (granucal, 1 thread), up to 10^6
@@ -238,8 +244,8 @@ fi
 for rep in $(seq 1 "$REPS"); do
   for n in $FLAT_SIZES; do
     echo "flatness: N=$n rep $rep/$REPS" >&2
-    run_granucal "$n" 1 "$rep" all "$(python3 -c "print(max(10, $(steps_for "$n")))")" "$DT"
-    sed -i '$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,flat,/' "$RAW"
+    run_granucal "$n" 1 "$rep" all "$(steps_for "$n")" "$DT"
+    relabel_last flat
   done
 done
 
