@@ -39,9 +39,10 @@ static void test_fill_and_rigid_turn(void **state)
     // A level bed, at the resolution of its own granules: across the central
     // 60 % of the surface that the angle is fitted to (at most 0.6 D), the
     // fitted line rises less than the largest granule's diameter. At this
-    // coarse lambda one granule is an eighth of the drum: fills of seeds 1-5
-    // gave 0.2-7.5 deg, all level to within a granule; a bed left tilted or
-    // piled by a wrong fill would stand at tens of degrees.
+    // coarse lambda the largest granule (10.3 mm) is a tenth of the drum:
+    // fills of seeds 1-5 gave 0.9-7.5 deg (seeds 1-3 with the previous order
+    // of summation: 0.2-1.8 deg), all level to within a granule; a bed left
+    // tilted or piled by a wrong fill would stand at tens of degrees.
     dem_granules_view g = dem_world_granules(w);
     double d_max = 0;
     for (size_t i = 0; i < g.count; ++i) d_max = fmax(d_max, 2 * g.radius[i]);
