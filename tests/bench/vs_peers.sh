@@ -297,13 +297,22 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'
                 "%.2f" % ratios['lammps'] if 'lammps' in ratios else ""))
             if code == 'granucal': summary[('ratio', n, th)] = ratios
     for th in ('1', '2'):
-        for v in ('norolling', 'notangential', 'all_default_wait', 'all_passive_wait'):
+        for v in ('norolling', 'notangential'):
             rs = [r for r in sel(N=str(n), threads=th, code='granucal', variant=v) if r['status'] == 'ok']
             if rs:
                 al = {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, code='granucal', variant='all')}
                 sp = med([num(r['psps']) / al[r['rep']] for r in rs if r['rep'] in al])
                 print("granucal %-14s N=%d thr=%s: %.3e p-steps/s, %.2fx all effects on" % (
                     v, n, th, med([num(r['psps']) for r in rs]), sp))
+        # The two wait policies ran back to back: compare them with each other,
+        # not with a main run of minutes before.
+        spin = {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, variant='all_default_wait') if r['status'] == 'ok'}
+        passive = {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, variant='all_passive_wait') if r['status'] == 'ok'}
+        pairs = [spin[k] / passive[k] for k in spin if k in passive]
+        if pairs:
+            print("granucal OpenMP wait N=%d thr=%s: default (spinning) %.3e, passive %.3e p-steps/s; spinning/passive "
+                  "back to back %s (median %.2f)" % (n, th, med(list(spin.values())), med(list(passive.values())),
+                                                       ", ".join("%.2f" % x for x in pairs), med(pairs)))
 
 print("\n== cost per particle-step against N (granucal, 1 thread, medians; memory is the process's peak RSS)")
 flat = {}
