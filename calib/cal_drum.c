@@ -36,10 +36,11 @@ static void write_json(FILE *f, const exp_drum_yaml *y, const exp_drum_result *r
             "\"k_n\": %g, \"lambda\": %g, \"seed\": %d, \"angle_deg\": %.4f, \"angle_sd_deg\": %.4f, "
             "\"csa_percent\": %.4f, \"csa_sd_percent\": %.4f, \"surface_fit_sd_m\": %.4g, \"steady\": %s, "
             "\"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"granules\": %zu, \"particle_steps\": %llu, "
-            "\"dt_s\": %.6g, \"effects\": \"%s\"}\n",
+            "\"dt_s\": %.6g, \"start_tilt_deg\": %g, \"effects\": \"%s\"}\n",
             status, y->rpm, y->wall, y->mu_s, y->mu_r, y->k_n, y->lambda, y->seed, r->angle_deg, r->angle_sd_deg,
             r->csa_percent, r->csa_sd_percent, r->fit_sd_m, r->steady ? "true" : "false", r->simulated_time_s,
-            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w), effects);
+            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w),
+            y->start_tilt_deg ? *y->start_tilt_deg : exp_default_drum_run_opts().start_tilt_deg, effects);
 }
 
 static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *r, const dem_world *w,

@@ -96,9 +96,9 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
     if (strcmp(turn_plate, fill_plate) == 0) snprintf(fill_plate, sizeof fill_plate, "same");
     snprintf(out, len,
              "%s filled_with_wall[%s] filled_with_plate[%s] rpm=%.10g max_time=%.10g sample=%.10g window=%.10g "
-             "tol=%.10g,%.10g network_dt=%d",
+             "tol=%.10g,%.10g network_dt=%d start_tilt=%.10g",
              def, fill_wall, c->def.periodic ? "none" : fill_plate, rpm, r->max_time, r->sample_interval, r->window,
-             r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt);
+             r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt, r->start_tilt_deg);
 }
 
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)

@@ -44,6 +44,7 @@ static const char help[] =
     "options:\n"
     "  --out DIR            results folder (default results/fidelity)\n"
     "  --budget-hours H     replaces fidelity.budget_hours\n"
+    "  --seeds N            replaces fidelity.seeds (1-16)\n"
     "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
     "  --jobs N             simulations side by side (default: cores)\n"
     "  -h, --help           this text\n"
@@ -62,7 +63,7 @@ static const struct {
 typedef struct options {
     const char *config, *out, *rungs;
     double budget_hours;
-    int jobs;
+    int jobs, seeds; ///< seeds 0: the config's
 } options;
 
 typedef struct rung_result {
@@ -92,23 +93,29 @@ static int parse_options(int argc, char **argv, options *o)
 {
     static const struct option longs[] = {{"out", required_argument, 0, 'o'}, {"budget-hours", required_argument, 0, 'b'},
                                           {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
-                                          {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+                                          {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
+                                          {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
     optind = 1;
     for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
-        char *end = NULL;
+        double v = NAN;
         switch (ch) {
         case 'o': o->out = optarg; break;
         case 'r': o->rungs = optarg; break;
         case 'b':
-            o->budget_hours = strtod(optarg, &end);
-            if (*end || !(o->budget_hours > 0))
+            if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
                 return fprintf(stderr, "granucal study: --budget-hours '%s': need a number > 0\n", optarg), 2;
             break;
         case 'j':
-            o->jobs = (int)strtol(optarg, &end, 10);
-            if (*end || o->jobs < 1) return fprintf(stderr, "granucal study: --jobs '%s': need an integer >= 1\n", optarg), 2;
+            if (exp_parse_number(optarg, &v) || v != floor(v) || !(v >= 1 && v <= 4096))
+                return fprintf(stderr, "granucal study: --jobs '%s': need an integer in [1, 4096]\n", optarg), 2;
+            o->jobs = (int)v;
+            break;
+        case 's':
+            if (exp_parse_number(optarg, &v) || v != floor(v) || !(v >= 1 && v <= 16))
+                return fprintf(stderr, "granucal study: --seeds '%s': need an integer in [1, 16]\n", optarg), 2;
+            o->seeds = (int)v;
             break;
         case 'h': fputs(help, stdout); return -1;
         default: fputs(help, stderr); return 2;
@@ -449,6 +456,7 @@ int cal_cmd_study(int argc, char **argv)
     s->c = cal_config_load(s->opt.config, NULL, s->err, sizeof s->err);
     if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
     else if (!s->c) status = 1;
+    if (!status && s->opt.seeds) s->c->fidelity->seeds = s->opt.seeds;
     if (!status) {
         snprintf(s->out, sizeof s->out, "%s", s->opt.out);
         status = cal_prepare_output(s->out, s->err, sizeof s->err);

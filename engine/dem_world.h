@@ -174,6 +174,14 @@ void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view
 /// granules travel), never between reading a view and using its indices.
 dem_status dem_world_sort_spatially(dem_world *w);
 
+/// Turn the whole granular state rigidly by `angle` (rad, right-handed) about
+/// the line through `point` along `axis`: positions, velocities, spins and
+/// every contact spring, so each contact keeps its force, turned. Walls do not
+/// move: use it for a bed inside a body of revolution about that line (a drum
+/// turned before its clock starts). Refused (DEM_ERR_INVALID, nothing changed)
+/// for an axis other than a periodic one, or if a granule would leave the domain.
+dem_status dem_world_rotate(dem_world *w, dem_vec3 point, dem_vec3 axis, double angle);
+
 /// Set a granule's velocity and spin (by view index).
 void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega);
 /// Zero every velocity and spin (keeps contact history).

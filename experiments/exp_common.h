@@ -15,7 +15,8 @@ const char *exp_version(void);
 /// written by an older engine is never served as this one's results.
 /// 2: forces added directly on one thread, wall near-lists, beds sorted along
 ///    a Morton curve after the fill (summation order).
-#define EXP_RESULTS_VERSION 2
+/// 3: the drum turns from a bed tilted 20° (exp_drum_run_opts.start_tilt_deg).
+#define EXP_RESULTS_VERSION 3
 const char *exp_results_version(void);
 
 /// Progress callback of long phases: phase name, simulated time, granules.

@@ -212,7 +212,15 @@ int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel
 exp_drum_run_opts exp_default_drum_run_opts(void)
 {
     return (exp_drum_run_opts){.rpm = 4, .max_time = 6, .sample_interval = 0.05, .window = 1.0,
-                               .angle_tol_deg = 1.0, .csa_tol_percent = 0.5, .adopt_network_dt = 1};
+                               .angle_tol_deg = 1.0, .csa_tol_percent = 0.5, .adopt_network_dt = 1,
+                               .start_tilt_deg = 20.0};
+}
+
+dem_status exp_drum_tilt(dem_world *w, double degrees)
+{
+    // The drum's axis is z through the origin (create_drum); a positive spin
+    // about +z turns it counter-clockwise seen from +z, as this does.
+    return dem_world_rotate(w, dem_v3(0, 0, 0), dem_v3(0, 0, 1), degrees * DEM_PI / 180.0);
 }
 
 typedef struct window_stats {
@@ -258,7 +266,9 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     int bad = dem_world_set_granule_contact(w, &granule) || dem_world_set_wall_contact(w, 0, &wall);
     for (int k = 1; k < (d->periodic ? 1 : 3) && !bad; ++k) bad = dem_world_set_wall_contact(w, k, &plate);
     if (bad) return DEM_ERR_INVALID;
-    dem_status st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
+    dem_status st = o->start_tilt_deg != 0 ? exp_drum_tilt(w, o->start_tilt_deg) : DEM_OK;
+    if (st != DEM_OK) return st;
+    st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
     if (st != DEM_OK) return st;
     // The end plates are part of the drum and turn with it (walls 1 and 2
     // of a full drum; they stood still before, dragging the bed's faces).
@@ -277,7 +287,10 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
         out->steady = is_steady(m, count, per_window, o);
         if (progress) progress("turn", dem_world_time(w) - t0, dem_world_granules(w).count, ctx);
     }
-    int from = count > per_window ? count - per_window : 0;
+    // The two windows the steady test compared are one state: both are
+    // averaged (a slumping bed's saw-tooth makes one window's mean depend on
+    // where in an avalanche cycle it starts).
+    int from = count > 2 * per_window ? count - 2 * per_window : 0;
     window_stats s = count ? stats_of(m, from, count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
     free(m);
     out->angle_deg = s.mean_angle, out->angle_sd_deg = s.sd_angle;

@@ -69,11 +69,21 @@ typedef struct exp_drum_run_opts {
     double angle_tol_deg;   ///< steady: window means of the angle agree within this (1.0°) + half their mean sd
     double csa_tol_percent; ///< ... and of the CSA within this (0.5 %) + half their mean sd
     int adopt_network_dt;   ///< turn at the settled bed's own network step limit (1)
+    /// The settled bed is first turned rigidly by this angle about the drum
+    /// axis, in the drum's sense (20°): as if the drum had already turned it,
+    /// which a real drum does before it avalanches. Saves the rigid turn a
+    /// level bed needs before its first avalanche (0.8 s of 6 s at 4 rpm).
+    double start_tilt_deg;
 } exp_drum_run_opts;
 
 exp_drum_run_opts exp_default_drum_run_opts(void);
 
-/// What a rotation run measured: means and spreads over the last window.
+/// Turn the bed rigidly by `degrees` about the drum axis in the sense a
+/// positive rpm turns the drum (dem_world_rotate: springs turn with it).
+dem_status exp_drum_tilt(dem_world *w, double degrees);
+
+/// What a rotation run measured: means and spreads over the last two windows
+/// (the pair the steady test compared; what there is of them if shorter).
 typedef struct exp_drum_result {
     double angle_deg, angle_sd_deg, csa_percent, csa_sd_percent;
     double fit_sd_m;        ///< mean spread of the surface about its fitted line

@@ -37,6 +37,7 @@ static const cyaml_schema_field_t drum_fields[] = {
                          &material_entry, 0, 16),
     REQ_FLOAT("rpm", rpm), REQ_FLOAT("max_time", max_time), OPT_FLOAT("window", window),
     OPT_FLOAT("sample_interval", sample_interval), OPT_FLOAT("pixel", pixel),
+    CYAML_FIELD_FLOAT_PTR("start_tilt_deg", CYAML_FLAG_OPTIONAL, exp_drum_yaml, start_tilt_deg),
     CYAML_FIELD_INT("closing_px", CYAML_FLAG_OPTIONAL, exp_drum_yaml, closing_px),
     CYAML_FIELD_INT("seed", CYAML_FLAG_OPTIONAL, exp_drum_yaml, seed), CYAML_FIELD_END};
 static const cyaml_schema_value_t drum_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, exp_drum_yaml, drum_fields)};
@@ -75,6 +76,13 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
             *numbers[k].field = v;
             return 0;
         }
+    if (strcmp(key, "start_tilt_deg") == 0) {
+        if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
+        if (!y->start_tilt_deg && !(y->start_tilt_deg = malloc(sizeof *y->start_tilt_deg)))
+            return exp_fail(err, len, "out of memory");
+        *y->start_tilt_deg = v;
+        return 0;
+    }
     if (strcmp(key, "seed") == 0) {
         if (exp_parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
             return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
@@ -82,7 +90,7 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         return 0;
     }
     return exp_fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
-                          "slice_depth, max_time)", key);
+                          "slice_depth, max_time, start_tilt_deg)", key);
 }
 
 static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char *name)
@@ -128,6 +136,7 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     run->rpm = y->rpm, run->max_time = y->max_time;
     if (y->window > 0) run->window = y->window;
     if (y->sample_interval > 0) run->sample_interval = y->sample_interval;
+    if (y->start_tilt_deg) run->start_tilt_deg = *y->start_tilt_deg;
     return 0;
 }
 
@@ -144,6 +153,8 @@ static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t 
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (!isfinite(numbers[k].v))
             return located(path, numbers[k].key, err, len, "%g must be a finite number", numbers[k].v);
+    if (y->start_tilt_deg && !(*y->start_tilt_deg >= 0 && *y->start_tilt_deg <= 90))
+        return located(path, "start_tilt_deg", err, len, "%g must be in [0, 90] degrees", *y->start_tilt_deg);
     if (y->window < 0) return located(path, "window", err, len, "%g must be >= 0 (0 or absent: 1 s)", y->window);
     if (y->sample_interval < 0)
         return located(path, "sample_interval", err, len, "%g must be >= 0 (0 or absent: 0.05 s)", y->sample_interval);

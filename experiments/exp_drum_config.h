@@ -30,6 +30,7 @@ typedef struct exp_drum_yaml {
     unsigned materials_count;
     double rpm, max_time, window, sample_interval;
     double pixel;
+    double *start_tilt_deg; ///< optional (NULL: exp_default_drum_run_opts' 20°)
     int closing_px;
     int seed;
 } exp_drum_yaml;

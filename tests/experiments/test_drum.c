@@ -2,7 +2,8 @@
 // The drum filled by bed volume has the fill degree's CSA; turned slowly, the
 // resting bed first turns with the drum as a rigid body, so its surface angle
 // grows at the drum's angular velocity (4 rpm = 24°/s) — an independent,
-// kinematic check of the rotating wall, the measurement and the units.
+// kinematic check of the rotating wall, the measurement and the units. The
+// start tilt turns the bed the same way, by its angle.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -50,6 +51,20 @@ static void test_fill_and_rigid_turn(void **state)
     printf("level: %.2f deg, allowed %.2f deg (largest granule %.2f mm over 0.6 D)\n", m0.angle_deg, level_deg,
            1e3 * d_max);
     assert_true(m0.angle_deg < level_deg);
+    // The start tilt (exp_drum_run_opts.start_tilt_deg) turns the bed rigidly
+    // in the drum's own sense: the surface turns by as much as the turn below
+    // does, the same way round, and the occupied area stays.
+    dem_world *tilted = dem_world_clone(w);
+    assert_non_null(tilted);
+    const double tilt = exp_default_drum_run_opts().start_tilt_deg;
+    assert_int_equal(exp_drum_tilt(tilted, tilt), DEM_OK);
+    exp_drum_measure mt;
+    assert_int_equal(exp_drum_measure_now(tilted, &d, pixel, d.closing_px, &mt), 0);
+    printf("start tilt %.0f deg: surface turned %.2f deg, CSA %.2f %%\n", tilt, mt.angle_signed_deg - m0.angle_signed_deg,
+           mt.csa_percent);
+    assert_true(fabs(mt.angle_signed_deg - m0.angle_signed_deg - tilt) < 0.15 * tilt);
+    assert_true(fabs(mt.csa_percent - m0.csa_percent) < 1.0);
+    dem_world_destroy(tilted);
     assert_int_equal(dem_world_adopt_network_dt(w), DEM_OK);
     double omega = 4 * 2 * DEM_PI / 60, t = 0.4;
     dem_world_set_wall_spin(w, 0, omega);

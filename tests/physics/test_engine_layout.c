@@ -11,7 +11,10 @@
 //    afar, across several list rebuilds, bounces; a wall added to a running
 //    world acts at once;
 //  - switching the tangential spring off and the rolling one on (same history
-//    length) restarts the springs instead of reading one as the other.
+//    length) restarts the springs instead of reading one as the other;
+//  - dem_world_rotate turns a loaded contact state rigidly: a pair sheared
+//    against a spinning drum wall, turned about the drum axis, runs on as the
+//    unturned one turned, to rounding; a refused rotation changes nothing.
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -334,6 +337,114 @@ static void test_tangential_to_rolling_restarts_springs(void **state)
     dem_world_destroy(w);
 }
 
+// -------------------------------------------------------- rigid rotation ---
+
+static dem_vec3 turned_about_z(dem_vec3 v, double angle)
+{
+    return dem_v3(v.x * cos(angle) - v.y * sin(angle), v.x * sin(angle) + v.y * cos(angle), v.z);
+}
+
+// A pair pressed together and sheared, the outer granule also pressed against
+// a spinning drum wall (axis z) and sliding along it: granule and wall
+// springs, tangential and rolling, all loaded. No gravity, which would not turn.
+static dem_world *pair_against_drum(void)
+{
+    dem_world_def def = dem_default_world_def();
+    def.gravity = dem_v3(0, 0, 0);
+    def.dt = 1e-6;
+    def.domain_lo = dem_v3(-0.01, -0.01, -0.01);
+    def.domain_hi = dem_v3(0.01, 0.01, 0.01);
+    dem_world *w = dem_world_create(&def, NULL, 0);
+    assert_non_null(w);
+    const double r = 1e-3;
+    dem_wall_def drum = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 0, 1}, .radius = 5 * r,
+                         .contact = def.granule, .name = "drum"};
+    drum.contact.k_n = drum.contact.k_s = drum.contact.k_r = 2 * def.granule.k_n;
+    assert_true(dem_world_add_wall(w, &drum) >= 0);
+    dem_world_set_wall_spin(w, 0, 2.0);
+    assert_true(dem_world_add_granule(w, dem_v3(4.1 * r, 0, 0), dem_v3(0.001, 0.01, 0.003), dem_v3(0, 0, 4), r, 1800) >= 0);
+    assert_true(dem_world_add_granule(w, dem_v3(2.2 * r, 0.3 * r, 0.1 * r), dem_v3(0.002, -0.003, 0.001),
+                                      dem_v3(1, 0, -3), r, 1800) >= 0);
+    assert_int_equal(dem_world_step(w, 40), DEM_OK); // springs loaded
+    dem_diagnostics d = dem_world_diagnose(w);
+    assert_int_equal(d.contacts, 1);
+    assert_int_equal(d.wall_contacts, 1);
+    return w;
+}
+
+// Largest gap between `turned` and `plain` turned by `angle`, over positions
+// (in radii), velocities and spins (relative to the largest of each).
+static double gap_after_turn(const dem_world *plain, const dem_world *turned, double angle)
+{
+    dem_granules_view a = dem_world_granules(plain), b = dem_world_granules(turned);
+    double v_scale = 0, w_scale = 0, worst = 0;
+    for (size_t i = 0; i < a.count; ++i)
+        v_scale = fmax(v_scale, dem_v3_norm(a.velocity[i])), w_scale = fmax(w_scale, dem_v3_norm(a.omega[i]));
+    for (size_t i = 0; i < a.count; ++i) {
+        worst = fmax(worst, dem_v3_norm(dem_v3_sub(turned_about_z(a.position[i], angle), b.position[i])) / a.radius[i]);
+        worst = fmax(worst, dem_v3_norm(dem_v3_sub(turned_about_z(a.velocity[i], angle), b.velocity[i])) / v_scale);
+        worst = fmax(worst, dem_v3_norm(dem_v3_sub(turned_about_z(a.omega[i], angle), b.omega[i])) / w_scale);
+    }
+    return worst;
+}
+
+static void test_rotation_turns_the_springs_with_the_bed(void **state)
+{
+    (void)state;
+    const double angle = 0.7;
+    const uint64_t steps = 300;
+    dem_world *plain = pair_against_drum(), *turned = dem_world_clone(plain), *restarted = dem_world_clone(plain);
+    assert_non_null(turned);
+    assert_non_null(restarted);
+    const double stored = dem_world_diagnose(plain).potential_elastic;
+    assert_int_equal(dem_world_rotate(turned, dem_v3(0, 0, 0), dem_v3(0, 0, 2), angle), DEM_OK);
+    assert_true(fabs(dem_world_diagnose(turned).potential_elastic - stored) <= 1e-12 * stored);
+    // Control: the same pair with its springs restarted (tangential off and
+    // on again), to show that the gap below would see a spring left unturned.
+    dem_contact_params p = dem_default_world_def().granule, no_slide = p;
+    no_slide.mu_s = 0;
+    assert_int_equal(dem_world_set_granule_contact(restarted, &no_slide), DEM_OK);
+    assert_int_equal(dem_world_set_granule_contact(restarted, &p), DEM_OK);
+    assert_int_equal(dem_world_step(plain, steps), DEM_OK);
+    assert_int_equal(dem_world_step(turned, steps), DEM_OK);
+    assert_int_equal(dem_world_step(restarted, steps), DEM_OK);
+    const double gap = gap_after_turn(plain, turned, angle), control = gap_after_turn(plain, restarted, 0.0);
+    printf("turned by %.2f rad about the drum axis, then %llu steps: largest gap to the plain run turned %.2e; "
+           "springs restarted instead: %.2e\n",
+           angle, (unsigned long long)steps, gap, control);
+    assert_true(gap < 1e-9);
+    assert_true(control > 1e3 * 1e-9);
+    dem_world_destroy(plain), dem_world_destroy(turned), dem_world_destroy(restarted);
+}
+
+static void test_refused_rotation_changes_nothing(void **state)
+{
+    (void)state;
+    dem_world *w = pair_against_drum(), *copy = dem_world_clone(w);
+    assert_non_null(copy);
+    // About a line far from the drum: the pair would leave the 2 cm box.
+    assert_int_equal(dem_world_rotate(w, dem_v3(0.009, 0.009, 0), dem_v3(0, 0, 1), 3.0), DEM_ERR_INVALID);
+    printf("refused: %s\n", dem_world_error(w));
+    assert_int_equal(dem_world_rotate(w, dem_v3(0, 0, 0), dem_v3(0, 0, 0), 1.0), DEM_ERR_INVALID);
+    dem_granules_view a = dem_world_granules(w), b = dem_world_granules(copy);
+    for (size_t i = 0; i < a.count; ++i) {
+        assert_vec_equal(a.position[i], b.position[i]);
+        assert_vec_equal(a.velocity[i], b.velocity[i]);
+    }
+    assert_int_equal(dem_world_step(w, 10), DEM_OK);
+    assert_int_equal(dem_world_step(copy, 10), DEM_OK);
+    a = dem_world_granules(w), b = dem_world_granules(copy);
+    for (size_t i = 0; i < a.count; ++i) assert_vec_equal(a.position[i], b.position[i]);
+    // A periodic world turns only about its periodic axis.
+    dem_world_def def = dem_default_world_def();
+    def.periodic_axis = 2;
+    dem_world *slab = dem_world_create(&def, NULL, 0);
+    assert_non_null(slab);
+    assert_int_equal(dem_world_rotate(slab, dem_v3(0, 0, 0), dem_v3(1, 0, 0), 0.1), DEM_ERR_INVALID);
+    assert_int_equal(dem_world_rotate(slab, dem_v3(0, 0, 0), dem_v3(0, 0, -1), 0.1), DEM_OK);
+    dem_world_destroy(w), dem_world_destroy(copy), dem_world_destroy(slab);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -343,6 +454,8 @@ int main(void)
         cmocka_unit_test(test_wall_reached_across_rebuilds),
         cmocka_unit_test(test_wall_added_to_running_world),
         cmocka_unit_test(test_tangential_to_rolling_restarts_springs),
+        cmocka_unit_test(test_rotation_turns_the_springs_with_the_bed),
+        cmocka_unit_test(test_refused_rotation_changes_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
