@@ -44,10 +44,8 @@ static void assert_vec_equal(dem_vec3 a, dem_vec3 b)
 
 // ------------------------------------------------------------- one pair ---
 
-// Two granules pressed together and sheared, so that both springs carry load;
-// the one added first lies further along the Morton curve, so sorting swaps
-// their indices and with them the roles i and j of their pair.
-static dem_world *sheared_pair(void)
+// A 2 cm box without gravity at a fixed 1 µs step, for one or two granules.
+static dem_world *small_weightless_world(void)
 {
     dem_world_def def = dem_default_world_def();
     def.gravity = dem_v3(0, 0, 0);
@@ -56,6 +54,15 @@ static dem_world *sheared_pair(void)
     def.domain_hi = dem_v3(0.01, 0.01, 0.01);
     dem_world *w = dem_world_create(&def, NULL, 0);
     assert_non_null(w);
+    return w;
+}
+
+// Two granules pressed together and sheared, so that both springs carry load;
+// the one added first lies further along the Morton curve, so sorting swaps
+// their indices and with them the roles i and j of their pair.
+static dem_world *sheared_pair(void)
+{
+    dem_world *w = small_weightless_world();
     const double r = 1e-3;
     // Centres 1.87 R apart (overlap 0.13 R), sliding past each other and spinning.
     assert_true(dem_world_add_granule(w, dem_v3(0.9 * r, 0.3 * r, 0.1 * r), dem_v3(-0.002, 0.003, 0), dem_v3(0, 0, 4),
@@ -349,17 +356,12 @@ static dem_vec3 turned_about_z(dem_vec3 v, double angle)
 // springs, tangential and rolling, all loaded. No gravity, which would not turn.
 static dem_world *pair_against_drum(void)
 {
-    dem_world_def def = dem_default_world_def();
-    def.gravity = dem_v3(0, 0, 0);
-    def.dt = 1e-6;
-    def.domain_lo = dem_v3(-0.01, -0.01, -0.01);
-    def.domain_hi = dem_v3(0.01, 0.01, 0.01);
-    dem_world *w = dem_world_create(&def, NULL, 0);
-    assert_non_null(w);
+    dem_world *w = small_weightless_world();
+    const dem_contact_params table3 = dem_default_world_def().granule;
     const double r = 1e-3;
     dem_wall_def drum = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 0, 1}, .radius = 5 * r,
-                         .contact = def.granule, .name = "drum"};
-    drum.contact.k_n = drum.contact.k_s = drum.contact.k_r = 2 * def.granule.k_n;
+                         .contact = table3, .name = "drum"};
+    drum.contact.k_n = drum.contact.k_s = drum.contact.k_r = 2 * table3.k_n;
     assert_true(dem_world_add_wall(w, &drum) >= 0);
     dem_world_set_wall_spin(w, 0, 2.0);
     assert_true(dem_world_add_granule(w, dem_v3(4.1 * r, 0, 0), dem_v3(0.001, 0.01, 0.003), dem_v3(0, 0, 4), r, 1800) >= 0);
