@@ -32,7 +32,8 @@ static const char help[] =
     "     keep the smallest k whose CN is within the seed-to-seed noise of the stiff limit;\n"
     "  2. granule-granule (mu_s, mu_r) in the drum lined with granules: NLopt COBYLA\n"
     "     minimises the occupied-area (CSA) misfit over the speeds subject to the dynamic\n"
-    "     angle of repose matching the lab's;\n"
+    "     angle of repose matching the lab's (a tier with `angle_rule: misfit` puts the\n"
+    "     angle into the misfit instead, for runs whose angle is as noisy as the band);\n"
     "  3. each wall material's (mu_s, mu_r), granule-granule frozen, the same way.\n"
     "\n"
     "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
@@ -224,7 +225,9 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
             return 1;
         const cal_candidate *b = &r->granule->cand[r->granule->best];
         *mu_s = b->mu_s, *mu_r = b->mu_r;
-        *source = r->granule->best_feasible ? "stage 2 (drum lined with granules)" : "stage 2, closest (angle not matched)";
+        *source = r->granule->best_feasible    ? "stage 2 (drum lined with granules)"
+                  : r->granule->angle_in_misfit ? "stage 2, best misfit (angle outside its tolerance)"
+                                                : "stage 2, closest (angle not matched)";
         return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, r->err, sizeof r->err);
     }
     stage_file s;
@@ -250,7 +253,10 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
         int t = r->table.n_walls++;
         snprintf(r->table.wall_name[t], 32, "%s", m->name);
         r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
-        snprintf(r->table.wall_source[t], 96, "%s", w->best_feasible ? "stage 3 (drum lined with it)" : "stage 3, closest (angle not matched)");
+        snprintf(r->table.wall_source[t], 96, "%s",
+                 w->best_feasible    ? "stage 3 (drum lined with it)"
+                 : w->angle_in_misfit ? "stage 3, best misfit (angle outside its tolerance)"
+                                      : "stage 3, closest (angle not matched)");
     }
     return 0;
 }

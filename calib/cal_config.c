@@ -39,6 +39,7 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
     TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
     TIER_FLOAT("angle_offset_deg", angle_offset_deg, CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -187,8 +188,12 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "angle_offset_deg", err, len, "%g must be in (-45, 45)", t->angle_offset_deg);
     for (unsigned k = 0; k < t->rpm_count; ++k)
         if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
+    if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
+        return located(c, from, "angle_rule", err, len, "'%s': use constraint (the paper's) or misfit", t->angle_rule);
     return 0;
 }
+
+int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
 
 static int check_fidelity(const cal_config *c, char *err, size_t len)
 {

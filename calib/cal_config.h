@@ -40,7 +40,17 @@ typedef struct cal_tier {
     double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
     double angle_offset_deg; ///< the tier's angle bias against the paper's fidelity (measured): the lab angle
                              ///< plus this is the target in the tier's own scale; 0 = none
+    /// How the angle enters the friction search: "constraint" (absent: the
+    /// paper's rule, sections 4.2-4.3: the angle within its tolerance first,
+    /// then the best CSA misfit) or "misfit" (the angle is one more
+    /// measurement in the misfit, weighed by its tolerance: for a tier whose
+    /// single-run angle noise is as wide as the tolerance band, where a hard
+    /// constraint lets that noise choose).
+    char *angle_rule;
 } cal_tier;
+
+/// 1 if the tier puts the angle into the misfit instead of a constraint.
+int cal_tier_angle_in_misfit(const cal_tier *t);
 
 /// A rung of the fidelity study: the drum's accuracy knobs only.
 typedef struct cal_rung {

@@ -285,8 +285,8 @@ static int plot_friction(const char *dir, const cal_outcome *o, const cal_fricti
     double running = HUGE_VAL;
     for (int i = 0; i < r->n; ++i) {
         mu_s[i] = r->cand[i].mu_s, mu_r[i] = r->cand[i].mu_r, angle[i] = r->cand[i].angle_deg;
-        misfit[i] = r->cand[i].misfit, index[i] = i + 1;
-        if (r->cand[i].angle_violation <= 0) running = fmin(running, misfit[i]);
+        misfit[i] = r->cand[i].objective, index[i] = i + 1;
+        if (r->angle_in_misfit || r->cand[i].angle_violation <= 0) running = fmin(running, misfit[i]);
         best[i] = isfinite(running) ? running : NAN;
     }
     char path[1200], title[160];
@@ -297,10 +297,12 @@ static int plot_friction(const char *dir, const cal_outcome *o, const cal_fricti
                            r->best, b->mu_s_min, b->mu_s_max, b->mu_r_min, b->mu_r_max, err, len))
         return 1;
     snprintf(path, sizeof path, "%s/convergence_%s.png", dir, stage);
-    cal_chart conv = {.title = "search convergence", .xlabel = "evaluation", .ylabel = "CSA misfit (mean squared z)",
+    cal_chart conv = {.title = "search convergence", .xlabel = "evaluation",
+                      .ylabel = r->angle_in_misfit ? "angle and CSA misfit (mean squared z)" : "CSA misfit (mean squared z)",
                       .log_y = 1, .hline = NAN};
     conv.series[conv.n_series++] = (cal_series_xy){"each candidate", index, misfit, NULL, r->n, 0, 1, 0.5, 0.5, 0.5};
-    conv.series[conv.n_series++] = (cal_series_xy){"best matching the angle", index, best, NULL, r->n, 1, 0, 0.8, 0.1, 0.1};
+    conv.series[conv.n_series++] = (cal_series_xy){r->angle_in_misfit ? "best so far" : "best matching the angle", index,
+                                                   best, NULL, r->n, 1, 0, 0.8, 0.1, 0.1};
     if (cal_plot_chart(path, &conv, err, len)) return 1;
     // CSA curves: the data, the chosen pair, and other pairs matching the angle (Fig. 16, 19).
     snprintf(path, sizeof path, "%s/csa_vs_rpm_%s.png", dir, stage);
@@ -336,11 +338,19 @@ static void report_friction(FILE *f, const cal_friction_result *r)
     fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. NLopt COBYLA: "
                "%s. %d candidates, %.0f s.\n\n",
             r->angle_tolerance, r->n_rpm, r->nlopt_result, r->n, r->wall_time_s);
+    if (r->angle_in_misfit)
+        fputs("Rule (`angle_rule: misfit`): the angle is one more measurement in the misfit, its z-score taken against "
+              "the tolerance, averaged with the CSA speeds' squared z-scores; the tier's angle noise is as wide as the "
+              "band, so a hard constraint would let that noise choose.\n\n", f);
     if (r->best >= 0) {
         const cal_candidate *b = &r->cand[r->best];
-        fprintf(f, "**Chosen:** μs = %.4g, μr = %.4g: angle %.2f° ± %.2f, CSA misfit %.3g%s.\n\n", b->mu_s, b->mu_r,
-                b->angle_deg, b->angle_sd_deg, b->misfit,
-                r->best_feasible ? "" : " — **no candidate matched the angle within its tolerance; this is the closest**");
+        char with_angle[64] = "";
+        if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", misfit with the angle %.3g", b->objective);
+        fprintf(f, "**Chosen:** μs = %.4g, μr = %.4g: angle %.2f° ± %.2f, CSA misfit %.3g%s%s.\n\n", b->mu_s, b->mu_r,
+                b->angle_deg, b->angle_sd_deg, b->misfit, with_angle,
+                r->best_feasible ? ""
+                : r->angle_in_misfit ? " (its angle is outside the tolerance)"
+                                     : " — **no candidate matched the angle within its tolerance; this is the closest**");
     }
     fputs("Pairs matching the angle within the tolerance (the paper's ambiguity):\n\n| μs | μr | angle (°) | CSA misfit |"
           "\n|---|---|---|---|\n", f);

@@ -5,7 +5,11 @@
 // their CSA curves; the best of them) as one problem for NLopt's COBYLA:
 //   minimise   the CSA misfit           (mean squared, in data standard deviations)
 //   subject to |angle - target| <= tol  (tol: the lab's and the tier's spreads combined)
-// over μs and log10 μr, scaled to the unit square. A grid over the square
+// over μs and log10 μr, scaled to the unit square. A tier whose single-run
+// angle noise is as wide as that band (angle_rule: misfit) instead minimises
+// one misfit over all measurements: the angle's squared z-score (by the same
+// tolerance) averaged with the CSA speeds' (a hard band would let the noise
+// choose among the pairs near its edges). A grid over the square
 // comes first: it maps the angle over the plane (Fig. 13, 17), shows the
 // ambiguity (every pair matching the angle) and starts COBYLA from its best
 // point. Every candidate uses the same seed and therefore the same settled
@@ -25,6 +29,8 @@
 static const double failed_speed_penalty = 25.0;
 /// The lab's CSA spread is floored: a quoted 0 would make one speed dominate.
 static const double min_csa_sd = 0.1;
+/// Likewise the angle's tolerance where it is a term of the misfit (°).
+static const double min_angle_sd = 0.1;
 
 typedef struct search {
     cal_env *env;
@@ -48,24 +54,37 @@ static double to_mu_r(const cal_bounds *b, double v)
 }
 static const cal_bounds *bounds_of(const search *s) { return s->material ? &s->c->wall : &s->c->granule; }
 
+void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
+{
+    k->angle_violation = isfinite(k->angle_deg) ? fabs(k->angle_deg - r->angle_target) - r->angle_tolerance : 90;
+    double sum = 0;
+    for (int i = 0; i < r->n_rpm; ++i) {
+        double z = (k->csa[i] - r->csa_data[i]) / fmax(r->csa_data_sd[i], min_csa_sd);
+        sum += k->usable[i] ? z * z : failed_speed_penalty;
+    }
+    k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
+    k->objective = k->misfit;
+    if (r->angle_in_misfit) {
+        double z = (k->angle_deg - r->angle_target) / fmax(r->angle_tolerance, min_angle_sd);
+        k->objective = ((isfinite(z) ? z * z : failed_speed_penalty) + sum) / (r->n_rpm + 1);
+    }
+}
+
+// The candidate's measurements from its records, then its scores.
 static void score(search *s, cal_candidate *k, const cal_record *rec)
 {
     cal_friction_result *r = s->r;
     const cal_record *a = &rec[s->angle_index];
     k->angle_deg = cal_record_usable(a) ? a->angle_deg : NAN;
     k->angle_sd_deg = a->angle_sd_deg;
-    k->angle_violation = isfinite(k->angle_deg) ? fabs(k->angle_deg - r->angle_target) - r->angle_tolerance : 90;
-    double sum = 0;
     for (int i = 0; i < r->n_rpm; ++i) {
         const cal_record *x = NULL;
         for (int j = 0; j < s->n_sim; ++j)
             if (s->sim_rpm[j] == r->rpm[i]) x = &rec[j];
         k->usable[i] = x && cal_record_usable(x) && x->steady;
         k->csa[i] = x ? x->csa_percent : NAN, k->csa_sd[i] = x ? x->csa_sd_percent : NAN;
-        double z = (k->csa[i] - r->csa_data[i]) / fmax(r->csa_data_sd[i], min_csa_sd);
-        sum += k->usable[i] ? z * z : failed_speed_penalty;
     }
-    k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
+    cal_candidate_score(r, k);
 }
 
 // "candidate i of at most N", with the time left at the pace so far.
@@ -103,9 +122,11 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
         k->wall_time_s += rec[i].wall_time_s + rec[i].fill_wall_time_s, cal_record_free(&rec[i]);
     double elapsed = exp_wall_seconds() - t0;
-    fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g (%.0f s)\n",
+    char with_angle[48] = "";
+    if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", with the angle %.3g", k->objective);
+    fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g%s (%.0f s)\n",
             s->env->tty ? "\r\033[K" : "", s->env->stage, r->n, mu_s, mu_r, k->angle_deg, r->angle_target,
-            r->angle_tolerance, k->misfit, elapsed);
+            r->angle_tolerance, k->misfit, with_angle, elapsed);
     return k;
 }
 
@@ -115,7 +136,7 @@ static double objective(unsigned n, const double *x, double *grad, void *ctx)
     search *s = ctx;
     cal_candidate *k = evaluate(s, x[0], x[1], 0);
     if (!k) return nlopt_force_stop(s->opt), HUGE_VAL;
-    return k->misfit;
+    return k->objective;
 }
 
 static double angle_constraint(unsigned n, const double *x, double *grad, void *ctx)
@@ -126,19 +147,21 @@ static double angle_constraint(unsigned n, const double *x, double *grad, void *
     return k ? k->angle_violation : 0;
 }
 
-// Feasible candidates first, by misfit; else the least violation.
-static int better(const cal_candidate *a, const cal_candidate *b)
+// Feasible candidates first, by misfit; else the least violation. With the
+// angle in the misfit: by that misfit alone.
+static int better(const cal_friction_result *r, const cal_candidate *a, const cal_candidate *b)
 {
+    if (r->angle_in_misfit) return a->objective < b->objective;
     int fa = a->angle_violation <= 0, fb = b->angle_violation <= 0;
     if (fa != fb) return fa;
     return fa ? a->misfit < b->misfit : a->angle_violation < b->angle_violation;
 }
 
-static int best_of(const cal_friction_result *r)
+int cal_friction_best(const cal_friction_result *r)
 {
     int best = -1;
     for (int i = 0; i < r->n; ++i)
-        if (isfinite(r->cand[i].angle_deg) && (best < 0 || better(&r->cand[i], &r->cand[best]))) best = i;
+        if (isfinite(r->cand[i].angle_deg) && (best < 0 || better(r, &r->cand[i], &r->cand[best]))) best = i;
     return best;
 }
 
@@ -151,7 +174,7 @@ static void unit_coordinates(const search *s, const cal_candidate *k, double *u,
 
 static const char *run_cobyla(search *s)
 {
-    int start = best_of(s->r);
+    int start = cal_friction_best(s->r);
     if (s->t->max_evaluations < 1) return "not run (max_evaluations = 0)";
     nlopt_opt opt = s->opt = nlopt_create(NLOPT_LN_COBYLA, 2);
     double lo[2] = {0, 0}, hi[2] = {1, 1}, x[2] = {0.5, 0.5}, fx;
@@ -160,7 +183,7 @@ static const char *run_cobyla(search *s)
     if (start >= 0) unit_coordinates(s, &s->r->cand[start], &x[0], &x[1]);
     nlopt_set_lower_bounds(opt, lo), nlopt_set_upper_bounds(opt, hi);
     nlopt_set_min_objective(opt, objective, s);
-    nlopt_add_inequality_constraint(opt, angle_constraint, s, 0.0);
+    if (!s->r->angle_in_misfit) nlopt_add_inequality_constraint(opt, angle_constraint, s, 0.0);
     nlopt_set_initial_step(opt, dx);
     nlopt_set_xtol_abs1(opt, 0.01); // 1 % of each range: finer than the drum can resolve at any tier
     nlopt_set_maxeval(opt, s->t->max_evaluations);
@@ -215,6 +238,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     snprintf(out->material, sizeof out->material, "%s", material ? material->name : "");
     snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
     out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
+    out->angle_in_misfit = cal_tier_angle_in_misfit(t);
     static char stage[64];
     snprintf(stage, sizeof stage, "%s", material ? material->name : "granule");
     env->stage = stage;
@@ -223,7 +247,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     for (int i = 0; i < t->grid && !s.failed; ++i)
         for (int j = 0; j < t->grid && !s.failed; ++j) evaluate(&s, (i + 0.5) / t->grid, (j + 0.5) / t->grid, 1);
     out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
-    out->best = best_of(out);
+    out->best = cal_friction_best(out);
     out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
     out->wall_time_s = exp_wall_seconds() - t0;
     if (s.failed) return 1;

@@ -44,6 +44,8 @@ typedef struct cal_candidate {
     int usable[CAL_MAX_RPM];            ///< steady and not failed
     double misfit;                      ///< mean squared CSA misfit in data standard deviations (+ penalties)
     double angle_violation;             ///< |angle - target| - tolerance (≤ 0: matches)
+    double objective;                   ///< what the search minimises: the CSA misfit, or with the
+                                        ///< angle's squared z-score as one more term (angle_in_misfit)
     int from_grid;
     double wall_time_s;
 } cal_candidate;
@@ -56,6 +58,7 @@ typedef struct cal_friction_result {
     double frozen_mu_s, frozen_mu_r;    ///< granule–granule pair (wall stage)
     double angle_target, angle_tolerance, angle_rpm; ///< target in the tier's scale: lab + offset
     double angle_lab, angle_offset;                  ///< the lab's angle and the tier's offset
+    int angle_in_misfit;                             ///< the tier's angle_rule is "misfit"
     int n_rpm;
     double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
     int n;                              ///< candidates evaluated
@@ -65,6 +68,13 @@ typedef struct cal_friction_result {
     const char *nlopt_result;
     double wall_time_s;
 } cal_friction_result;
+
+/// A candidate's scores from its measurements (angle_deg, csa, usable):
+/// angle_violation, the CSA misfit and the search's objective, by the rule
+/// in r (angle_in_misfit, targets, tolerance, data).
+void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
+/// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
+int cal_friction_best(const cal_friction_result *r);
 
 /// Stage 2 (material == NULL) or 3 (a material of the config).
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,

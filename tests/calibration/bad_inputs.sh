@@ -38,6 +38,7 @@ expect "negative friction" "pour_mu_s.yaml:" -- "$(edit pour_mu_s 's/^pour_mu_s:
 expect "fill above 100 %" "fill: 1.5 must be in (0, 1)" -- "$(edit fill 's/^fill: 0.43/fill: 1.5/')" "${out[@]}"
 expect "text in a number" ": xi: Invalid FLOAT value" -- "$(edit xi 's/^xi: 0.7/xi: high/')" "${out[@]}"
 expect "unknown key" "viscosity: Unexpected key" -- "$(edit key 's/^seed: 1/seed: 1\nviscosity: 2/')" "${out[@]}"
+expect "unknown angle rule" "angle_rule: 'maybe'" -- "$(edit rule 's/angle_rule: misfit/angle_rule: maybe/')" "${out[@]}"
 expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
 expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
