@@ -16,7 +16,15 @@
 // every simulation were exact: 0.25 x 0.9 = 0.225 in mu_s (both bounds span
 // 0.1-1), 0.25 x 2.70 = 0.68 decades in granule mu_r (1e-3 - 0.5) and
 // 0.25 x 4.70 = 1.17 decades in wall mu_r (1e-5 - 0.5). These are the
-// tolerances; none was changed after a run.
+// tolerances so far; none was changed after a run.
+//
+// The issue asks for tolerances from the tier's measured spread as well. The
+// protocol, fixed here before its runs finished: the ci calibration is run at
+// the config's seeds 2, 3 and 4 beside seed 1 (results/table3_ci/r3_misfit/);
+// an entry's spread is its sample standard deviation over the four runs (mu_s
+// as a value, mu_r and k_n in decades); its tolerance becomes the larger of
+// the search resolution above and twice that spread. The replicate runs go to
+// results/table3_ci/r3_seeds/.
 static const tolerance tolerances[] = {
     // Inputs and rules: the table must carry them exactly.
     {"granule-granule", "*", "density", 0, 1e-9, "config input (section 3.1)"},
