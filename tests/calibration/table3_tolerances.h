@@ -15,8 +15,8 @@
 // A calibrated value can therefore be off by a quarter of its axis even when
 // every simulation were exact: 0.25 x 0.9 = 0.225 in mu_s (both bounds span
 // 0.1-1), 0.25 x 2.70 = 0.68 decades in granule mu_r (1e-3 - 0.5) and
-// 0.25 x 4.70 = 1.17 decades in wall mu_r (1e-5 - 0.5). These are the
-// tolerances so far; none was changed after a run.
+// 0.25 x 4.70 = 1.17 decades in wall mu_r (1e-5 - 0.5). These were the
+// tolerances until the protocol below was run; none was changed after a run.
 //
 // The issue asks for tolerances from the tier's measured spread as well. The
 // protocol, fixed here before its runs finished: the ci calibration is run at
@@ -24,23 +24,37 @@
 // an entry's spread is its sample standard deviation over the four runs (mu_s
 // as a value, mu_r and k_n in decades); its tolerance becomes the larger of
 // the search resolution above and twice that spread. The replicate runs go to
-// results/table3_ci/r3_seeds/.
+// results/table3_ci/r3_seeds/ (spread.md: every value, spread and tolerance,
+// made by tests/calibration/spread_table.py). Outcome: wider tolerances for
+// k_n, the granule mu_r and the aluminium pair (their seeds scatter); none
+// for the PP and PTFE mu_r, which all four seeds put at 0.033 against Table 3's
+// 1e-4 (+2.52 decades): a bias of the tier, not noise, and still outside.
 static const tolerance tolerances[] = {
     // Inputs and rules: the table must carry them exactly.
     {"granule-granule", "*", "density", 0, 1e-9, "config input (section 3.1)"},
     {"granule-granule", "*", "xi", 0, 1e-9, "config input (Table 3)"},
     {"granule-boundary", "*", "xi", 0, 1e-9, "config input (Table 3)"},
-    {"granule-granule", "*", "k_s", 1, 0.302, "k_s = k_n (Table 3): follows k_n"},
-    {"granule-granule", "*", "k_r", 1, 0.302, "k_r = k_n (Table 3): follows k_n"},
-    {"granule-boundary", "*", "k_n", 1, 0.302, "2 k_n, springs in series (Table 3): follows k_n"},
-    {"granule-boundary", "*", "k_s", 1, 0.302, "2 k_n (Table 3): follows k_n"},
-    {"granule-boundary", "*", "k_r", 1, 0.302, "2 k_n (Table 3): follows k_n"},
-    // Calibrated.
-    {"granule-granule", "*", "k_n", 1, 0.302,
-     "one rung of the candidate ladder (factor 2): stage 1 can only land on a candidate"},
-    {"granule-granule", "*", "mu_s", 0, 0.225, "ci search resolution: 1/4 of the mu_s axis (0.1-1)"},
-    {"granule-granule", "*", "mu_r", 1, 0.68, "ci search resolution: 1/4 of the log mu_r axis (1e-3 - 0.5)"},
-    {"granule-boundary", "*", "mu_s", 0, 0.225, "ci search resolution: 1/4 of the mu_s axis (0.1-1)"},
-    {"granule-boundary", "*", "mu_r", 1, 1.17,
-     "ci search resolution: 1/4 of the log mu_r axis (1e-5 - 0.5); the wall mu_r spans decades (Fig. 17)"},
+    // Stage 1 and the rules that follow it: k_n's spread over the four seeds
+    // (200, 200, 100, 400 N/m: sd 0.246 decades, twice 0.492) is above one rung
+    // of the ladder (a factor 2, 0.302 decades); k_s, k_r and the boundary's
+    // 2 k_n (Table 3) carry the same deviation.
+    {"granule-granule", "*", "k_n", 1, 0.492, "twice the ci seeds' spread (0.246 dec) > one ladder rung (0.302)"},
+    {"granule-granule", "*", "k_s", 1, 0.492, "k_s = k_n (Table 3): follows k_n"},
+    {"granule-granule", "*", "k_r", 1, 0.492, "k_r = k_n (Table 3): follows k_n"},
+    {"granule-boundary", "*", "k_n", 1, 0.492, "2 k_n, springs in series (Table 3): follows k_n"},
+    {"granule-boundary", "*", "k_s", 1, 0.492, "2 k_n (Table 3): follows k_n"},
+    {"granule-boundary", "*", "k_r", 1, 0.492, "2 k_n (Table 3): follows k_n"},
+    // Calibrated friction: the larger of the resolution and twice the spread
+    // over the four seeds (results/table3_ci/r3_seeds/spread.md).
+    {"granule-granule", "*", "mu_s", 0, 0.225, "ci search resolution (seeds' spread 0.112, twice 0.224)"},
+    {"granule-granule", "*", "mu_r", 1, 1.35, "twice the seeds' spread (0.675 dec) > resolution (0.68 dec)"},
+    {"granule-boundary", "aluminium", "mu_s", 0, 0.26, "twice the seeds' spread (0.13) > resolution (0.225)"},
+    {"granule-boundary", "aluminium", "mu_r", 1, 2.71,
+     "twice the seeds' spread (1.36 dec: 0.033 or 1.5e-4 by seed) > resolution (1.17 dec); the wall mu_r spans decades"},
+    {"granule-boundary", "PP", "mu_s", 0, 0.26, "twice the seeds' spread (0.13) > resolution (0.225)"},
+    {"granule-boundary", "PP", "mu_r", 1, 1.17,
+     "ci search resolution (1e-5 - 0.5); all four seeds gave 0.033: no spread"},
+    {"granule-boundary", "PTFE", "mu_s", 0, 0.26, "twice the seeds' spread (0.13) > resolution (0.225)"},
+    {"granule-boundary", "PTFE", "mu_r", 1, 1.17,
+     "ci search resolution (1e-5 - 0.5); all four seeds gave 0.033: no spread"},
 };
