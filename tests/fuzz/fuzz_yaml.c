@@ -62,6 +62,9 @@ static void check_config(const cal_config *c, const char *path)
         finite(L, "tier steady_angle_tol_deg", t->steady_angle_tol_deg), finite(L, "tier angle_sd_deg", t->angle_sd_deg);
         finite(L, "tier steady_csa_tol_percent", t->steady_csa_tol_percent);
         for (unsigned j = 0; j < t->rpm_count; ++j) finite(L, "tier rpm", t->rpm[j]);
+        finite(L, "tier angle_offset_deg", t->angle_offset_deg);
+        if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
+            fuzz_violation("cal_config_load accepted an unknown angle_rule", t->angle_rule);
     }
     if (c->fidelity) {
         const cal_fidelity *f = c->fidelity;
@@ -115,6 +118,8 @@ static void load_drum(const char *path, int n_sets, char **sets)
         finite(L, "material mu_s", y->materials[k].mu_s), finite(L, "material mu_r", y->materials[k].mu_r);
     finite(L, "rpm", run.rpm), finite(L, "max_time", run.max_time), finite(L, "window", run.window);
     finite(L, "sample_interval", run.sample_interval);
+    if (!(run.start_tilt_deg >= 0 && run.start_tilt_deg <= 90))
+        fuzz_violation("exp_drum_config_load accepted a start tilt outside [0, 90] degrees", NULL);
     if (!(run.max_time > 0 && run.window > 0 && run.sample_interval > 0))
         fuzz_violation("exp_drum_config_load accepted a non-positive time", NULL);
     exp_drum_config_free(y);
