@@ -39,8 +39,7 @@ static void write_json(FILE *f, const exp_drum_yaml *y, const exp_drum_result *r
             "\"dt_s\": %.6g, \"start_tilt_deg\": %g, \"effects\": \"%s\"}\n",
             status, y->rpm, y->wall, y->mu_s, y->mu_r, y->k_n, y->lambda, y->seed, r->angle_deg, r->angle_sd_deg,
             r->csa_percent, r->csa_sd_percent, r->fit_sd_m, r->steady ? "true" : "false", r->simulated_time_s,
-            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w),
-            y->start_tilt_deg ? *y->start_tilt_deg : exp_default_drum_run_opts().start_tilt_deg, effects);
+            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w), r->start_tilt_deg, effects);
 }
 
 static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *r, const dem_world *w,

@@ -108,12 +108,12 @@ static int parse_options(int argc, char **argv, options *o)
                 return fprintf(stderr, "granucal study: --budget-hours '%s': need a number > 0\n", optarg), 2;
             break;
         case 'j':
-            if (exp_parse_number(optarg, &v) || v != floor(v) || !(v >= 1 && v <= 4096))
+            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 4096))
                 return fprintf(stderr, "granucal study: --jobs '%s': need an integer in [1, 4096]\n", optarg), 2;
             o->jobs = (int)v;
             break;
         case 's':
-            if (exp_parse_number(optarg, &v) || v != floor(v) || !(v >= 1 && v <= 16))
+            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 16))
                 return fprintf(stderr, "granucal study: --seeds '%s': need an integer in [1, 16]\n", optarg), 2;
             o->seeds = (int)v;
             break;

@@ -20,6 +20,12 @@ static dem_vec3 rotated(const rotation *r, dem_vec3 v)
     return dem_v3_axpy(dem_v3_dot(r->k, v) * (1.0 - r->c), r->k, out);
 }
 
+// A point turned about the line through `point`.
+static dem_vec3 turned_point(const rotation *r, dem_vec3 point, dem_vec3 p)
+{
+    return dem_v3_add(point, rotated(r, dem_v3_sub(p, point)));
+}
+
 // `count` consecutive 3-vectors stored as doubles (springs: every history
 // slot is a vector, dem_history_len).
 static void rotate_triples(const rotation *r, double *a, size_t count)
@@ -43,12 +49,6 @@ static void rotate_symmetric(const rotation *r, double *d)
     d[0] = row_x.x, d[1] = row_y.y, d[2] = row_z.z, d[3] = row_x.y, d[4] = row_x.z, d[5] = row_y.z;
 }
 
-static int inside_domain(const dem_world *w, dem_vec3 p)
-{
-    const dem_vec3 lo = w->def.domain_lo, hi = w->def.domain_hi;
-    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
-}
-
 dem_status dem_world_rotate(dem_world *w, dem_vec3 point, dem_vec3 axis, double angle)
 {
     const double len = dem_v3_norm(axis);
@@ -65,12 +65,12 @@ dem_status dem_world_rotate(dem_world *w, dem_vec3 point, dem_vec3 axis, double 
         return DEM_ERR_INVALID;
     }
     for (size_t i = 0; i < w->n; ++i) // first check, so that a refusal changes nothing
-        if (!inside_domain(w, dem_v3_add(point, rotated(&r, dem_v3_sub(w->pos[i], point))))) {
+        if (!dem_v3_in_box(turned_point(&r, point, w->pos[i]), w->def.domain_lo, w->def.domain_hi)) {
             dem_world_set_error(w, "rotation: granule id %llu would leave the domain", (unsigned long long)w->id[i]);
             return DEM_ERR_INVALID;
         }
     for (size_t i = 0; i < w->n; ++i) {
-        w->pos[i] = dem_v3_add(point, rotated(&r, dem_v3_sub(w->pos[i], point)));
+        w->pos[i] = turned_point(&r, point, w->pos[i]);
         w->vel[i] = rotated(&r, w->vel[i]);
         w->omg[i] = rotated(&r, w->omg[i]);
         // The contact forces at the turned configuration are the old ones

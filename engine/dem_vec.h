@@ -37,6 +37,11 @@ static inline dem_vec3 dem_v3_cross(dem_vec3 a, dem_vec3 b)
 }
 /// Component a (0 x, 1 y, 2 z).
 static inline double dem_v3_comp(dem_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
+/// Whether p lies in the box [lo, hi] (boundaries included; NaN never does).
+static inline int dem_v3_in_box(dem_vec3 p, dem_vec3 lo, dem_vec3 hi)
+{
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+}
 static inline dem_vec3 dem_v3_neg(dem_vec3 a) { return dem_v3(-a.x, -a.y, -a.z); }
 static inline int dem_v3_isfinite(dem_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 

@@ -39,7 +39,6 @@ int dem_world_set_error(dem_world *w, const char *fmt, ...)
     return 1;
 }
 
-
 static int check_def(const dem_world_def *d, char *msg, size_t len)
 {
     char sub[256];
@@ -465,8 +464,7 @@ static size_t kick_drift(dem_world *restrict w, int *escaped)
             *pc[pa] -= len * floor((*pc[pa] - l) / len);
         }
         w->pos[i] = p;
-        int out = !(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z);
-        if (out && i < first_bad) first_bad = i;
+        if (!dem_v3_in_box(p, lo, hi) && i < first_bad) first_bad = i;
     }
     *escaped = first_bad != SIZE_MAX;
     return first_bad;

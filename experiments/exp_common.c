@@ -50,6 +50,8 @@ int exp_parse_number(const char *text, double *out)
     return errno != 0 || end == text || *end != '\0' || !isfinite(*out);
 }
 
+int exp_integer_in(double v, double lo, double hi) { return v == floor(v) && v >= lo && v <= hi; }
+
 int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len)
 {
     const char *text = NULL;

@@ -34,6 +34,8 @@ double exp_wall_seconds(void);
 int exp_split_set(const char *set, char key[32], const char **value, char *err, size_t len);
 /// A finite number that fills the whole text: 0, else 1.
 int exp_parse_number(const char *text, double *out);
+/// 1 if v is a whole number in [lo, hi] (a seed, a count), else 0.
+int exp_integer_in(double v, double lo, double hi);
 /// exp_split_set for a value that must be a finite number: 0, else 1 with a
 /// message naming the key.
 int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len);

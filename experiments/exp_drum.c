@@ -268,6 +268,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     if (bad) return DEM_ERR_INVALID;
     dem_status st = o->start_tilt_deg != 0 ? exp_drum_tilt(w, o->start_tilt_deg) : DEM_OK;
     if (st != DEM_OK) return st;
+    out->start_tilt_deg = o->start_tilt_deg;
     st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
     if (st != DEM_OK) return st;
     // The end plates are part of the drum and turn with it (walls 1 and 2

@@ -87,6 +87,7 @@ dem_status exp_drum_tilt(dem_world *w, double degrees);
 typedef struct exp_drum_result {
     double angle_deg, angle_sd_deg, csa_percent, csa_sd_percent;
     double fit_sd_m;        ///< mean spread of the surface about its fitted line
+    double start_tilt_deg;  ///< the start tilt the bed was turned by (exp_drum_run_opts)
     int steady;             ///< 1 if the window criterion held before max_time
     double simulated_time_s, wall_time_s;
     unsigned long long particle_steps;

@@ -84,7 +84,7 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         return 0;
     }
     if (strcmp(key, "seed") == 0) {
-        if (exp_parse_number(value, &v) || v < 0 || v != floor(v) || v > 2147483647.0)
+        if (exp_parse_number(value, &v) || !exp_integer_in(v, 0, 2147483647.0))
             return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
         y->seed = (int)v;
         return 0;

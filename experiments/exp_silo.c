@@ -400,7 +400,7 @@ static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
     if (strcmp(key, "seed") == 0 || strcmp(key, "n_granules") == 0) {
-        if (v < 0 || v != floor(v) || v > 2147483647.0) return exp_fail(err, len, "--set %s: %g is not a non-negative integer", key, v);
+        if (!exp_integer_in(v, 0, 2147483647.0)) return exp_fail(err, len, "--set %s: %g is not a non-negative integer", key, v);
         *(strcmp(key, "seed") == 0 ? &y->seed : &y->n_granules) = (int)v;
         return 0;
     }
