@@ -101,14 +101,19 @@ static int parse_options(int argc, char **argv, options *o)
 
 typedef struct stage_file {
     double k_n, mu_s, mu_r;
+    double mu_s_identified_min, mu_s_identified_max, mu_r_identified_min, mu_r_identified_max; ///< absent: 0
 } stage_file;
+#define STAGE_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, stage_file, member)
 static const cyaml_schema_field_t stage_fields[] = {
-    CYAML_FIELD_FLOAT("k_n", CYAML_FLAG_OPTIONAL, stage_file, k_n),
-    CYAML_FIELD_FLOAT("mu_s", CYAML_FLAG_OPTIONAL, stage_file, mu_s),
-    CYAML_FIELD_FLOAT("mu_r", CYAML_FLAG_OPTIONAL, stage_file, mu_r), CYAML_FIELD_END};
+    STAGE_FLOAT("k_n", k_n), STAGE_FLOAT("mu_s", mu_s), STAGE_FLOAT("mu_r", mu_r),
+    STAGE_FLOAT("mu_s_identified_min", mu_s_identified_min), STAGE_FLOAT("mu_s_identified_max", mu_s_identified_max),
+    STAGE_FLOAT("mu_r_identified_min", mu_r_identified_min), STAGE_FLOAT("mu_r_identified_max", mu_r_identified_max),
+    CYAML_FIELD_END};
 static const cyaml_schema_value_t stage_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, stage_file, stage_fields)};
 
-static int write_stage(const char *dir, const char *name, double k_n, double mu_s, double mu_r, char *err, size_t len)
+// ranges: the identified μs and μr ranges, or NULL (stage 1).
+static int write_stage(const char *dir, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2],
+                       char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
@@ -116,7 +121,20 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
     if (cal_atomic_open(&a, path, err, len)) return 1;
     fprintf(a.f, "# written by granucal calibrate; read by later stages run alone\nk_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
             k_n, mu_s, mu_r);
+    if (ranges && isfinite(ranges[1].lo))
+        fprintf(a.f, "mu_s_identified_min: %.17g\nmu_s_identified_max: %.17g\nmu_r_identified_min: %.17g\n"
+                     "mu_r_identified_max: %.17g\n",
+                ranges[0].lo, ranges[0].hi, ranges[1].lo, ranges[1].hi);
     return cal_atomic_commit(&a, err, len);
+}
+
+// The identified ranges a stage file kept (NAN if none: μr's range is never 0).
+static void stage_ranges(const stage_file *s, cal_range *mu_s, cal_range *mu_r)
+{
+    *mu_s = *mu_r = (cal_range){NAN, NAN, NAN, NAN};
+    if (!(s->mu_r_identified_min > 0)) return;
+    mu_s->lo = s->mu_s_identified_min, mu_s->hi = s->mu_s_identified_max;
+    mu_r->lo = s->mu_r_identified_min, mu_r->hi = s->mu_r_identified_max;
 }
 
 // 1 if the stage file exists and was read; -1 if it is damaged.
@@ -201,10 +219,10 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
             fprintf(stderr, "stage 1: the CN of the softest candidate is within the noise of the stiff limit: the sweep "
                             "does not resolve the stiffness at this tier; using the config's k_n = %g N/m\n", r->c->k_n);
             *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
-            return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, r->err, sizeof r->err);
+            return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
         }
         *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)";
-        return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, r->err, sizeof r->err);
+        return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
     }
     stage_file s;
     int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
@@ -225,15 +243,20 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
             return 1;
         const cal_candidate *b = &r->granule->cand[r->granule->best];
         *mu_s = b->mu_s, *mu_r = b->mu_r;
+        r->table.gg_mu_s_range = r->granule->mu_s_range, r->table.gg_mu_r_range = r->granule->mu_r_range;
         *source = r->granule->best_feasible    ? "stage 2 (drum lined with granules)"
                   : r->granule->angle_in_misfit ? "stage 2, best misfit (angle outside its tolerance)"
                                                 : "stage 2, closest (angle not matched)";
-        return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, r->err, sizeof r->err);
+        const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
+        return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
     }
     stage_file s;
     int got = read_stage(r->out, "granule", &s, r->err, sizeof r->err);
     if (got < 0) return 1;
-    if (got) *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
+    if (got) {
+        *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
+        stage_ranges(&s, &r->table.gg_mu_s_range, &r->table.gg_mu_r_range);
+    }
     return 0;
 }
 
@@ -253,6 +276,7 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
         int t = r->table.n_walls++;
         snprintf(r->table.wall_name[t], 32, "%s", m->name);
         r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
+        r->table.wall_mu_s_range[t] = w->mu_s_range, r->table.wall_mu_r_range[t] = w->mu_r_range;
         snprintf(r->table.wall_source[t], 96, "%s",
                  w->best_feasible    ? "stage 3 (drum lined with it)"
                  : w->angle_in_misfit ? "stage 3, best misfit (angle outside its tolerance)"
@@ -276,6 +300,7 @@ static int calibrate(run *r, const char *command)
     double k_n, gg_mu_s, gg_mu_r;
     const char *k_source, *gg_source;
     r->env.started = exp_wall_seconds();
+    r->table.gg_mu_s_range = r->table.gg_mu_r_range = (cal_range){NAN, NAN, NAN, NAN}; // until stage 2 says
     if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
         stage_walls(r, k_n, gg_mu_s, gg_mu_r))
         return 1;

@@ -40,6 +40,9 @@ static const cyaml_schema_field_t tier_fields[] = {
     TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
     TIER_FLOAT("angle_offset_deg", angle_offset_deg, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
+    CYAML_FIELD_SEQUENCE("csa_sd_percent", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, csa_sd_percent,
+                         &float_entry, 1, 32),
+    CYAML_FIELD_BOOL("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, bound_probes),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -190,10 +193,23 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
     if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
         return located(c, from, "angle_rule", err, len, "'%s': use constraint (the paper's) or misfit", t->angle_rule);
+    if (t->csa_sd_percent_count > 1 && t->csa_sd_percent_count != t->rpm_count)
+        return located(c, from, "csa_sd_percent", err, len, "%u values for %u speeds: give one value, or one per rpm",
+                       t->csa_sd_percent_count, t->rpm_count);
+    for (unsigned k = 0; k < t->csa_sd_percent_count; ++k)
+        if (!(t->csa_sd_percent[k] >= 0 && t->csa_sd_percent[k] < 50))
+            return located(c, from, "csa_sd_percent", err, len, "%g must be in [0, 50) percentage points",
+                           t->csa_sd_percent[k]);
     return 0;
 }
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
+int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
+double cal_tier_csa_sd(const cal_tier *t, unsigned i)
+{
+    if (t->csa_sd_percent_count == 0) return 0;
+    return t->csa_sd_percent[t->csa_sd_percent_count == 1 ? 0 : i];
+}
 
 static int check_fidelity(const cal_config *c, char *err, size_t len)
 {

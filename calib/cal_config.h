@@ -7,6 +7,7 @@
 #ifndef CAL_CONFIG_H
 #define CAL_CONFIG_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 /// A wall material to fit: its name in the table and its drum lining's name
@@ -47,10 +48,24 @@ typedef struct cal_tier {
     /// single-run angle noise is as wide as the tolerance band, where a hard
     /// constraint lets that noise choose).
     char *angle_rule;
+    /// The tier's own seed-to-seed spread of one run's CSA (percentage points),
+    /// measured with `granucal study fidelity --seeds N` on the tier's drum:
+    /// one value for every speed, or one per entry of rpm. With the lab's
+    /// spread it sets which candidates the data cannot tell apart (the
+    /// identified ranges); absent: the lab's spread alone.
+    double *csa_sd_percent;
+    unsigned csa_sd_percent_count;
+    /// After the search, the best μs with μr at each search bound, so that the
+    /// identified μr range says whether the data bound it (absent: true).
+    bool *bound_probes;
 } cal_tier;
 
 /// 1 if the tier puts the angle into the misfit instead of a constraint.
 int cal_tier_angle_in_misfit(const cal_tier *t);
+/// 1 if the tier probes the μr bounds after the search (the default).
+int cal_tier_bound_probes(const cal_tier *t);
+/// The tier's CSA spread at speed index i of its rpm list (0: not measured).
+double cal_tier_csa_sd(const cal_tier *t, unsigned i);
 
 /// A rung of the fidelity study: the drum's accuracy knobs only.
 typedef struct cal_rung {

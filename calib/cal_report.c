@@ -21,24 +21,27 @@ typedef struct row {
     const char *parameter;
     double value;
     const char *unit;
+    cal_range range; ///< identified range of a calibrated friction; NAN otherwise
 } row;
+
+static const cal_range no_range = {NAN, NAN, NAN, NAN};
 
 static int table_rows(const cal_table *t, row *rows)
 {
     int n = 0;
     const char *names[] = {"k_n", "k_s", "k_r"};
-    rows[n++] = (row){"granule-granule", "", "density", t->density, "kg/m3"};
-    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-granule", "", names[k], t->k_n, "N/m"};
-    rows[n++] = (row){"granule-granule", "", "xi", t->xi, "-"};
-    rows[n++] = (row){"granule-granule", "", "mu_s", t->gg_mu_s, "-"};
-    rows[n++] = (row){"granule-granule", "", "mu_r", t->gg_mu_r, "-"};
+    rows[n++] = (row){"granule-granule", "", "density", t->density, "kg/m3", no_range};
+    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-granule", "", names[k], t->k_n, "N/m", no_range};
+    rows[n++] = (row){"granule-granule", "", "xi", t->xi, "-", no_range};
+    rows[n++] = (row){"granule-granule", "", "mu_s", t->gg_mu_s, "-", t->gg_mu_s_range};
+    rows[n++] = (row){"granule-granule", "", "mu_r", t->gg_mu_r, "-", t->gg_mu_r_range};
     // Table 3: a rigid boundary in series with the granule's own spring: 2 k_n.
-    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], 2 * t->k_n, "N/m"};
-    rows[n++] = (row){"granule-boundary", "", "xi", t->xi, "-"};
+    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], 2 * t->k_n, "N/m", no_range};
+    rows[n++] = (row){"granule-boundary", "", "xi", t->xi, "-", no_range};
     for (int w = 0; w < t->n_walls; ++w) {
-        rows[n] = (row){"granule-boundary", "", "mu_s", t->wall_mu_s[w], "-"};
+        rows[n] = (row){"granule-boundary", "", "mu_s", t->wall_mu_s[w], "-", t->wall_mu_s_range[w]};
         snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
-        rows[n] = (row){"granule-boundary", "", "mu_r", t->wall_mu_r[w], "-"};
+        rows[n] = (row){"granule-boundary", "", "mu_r", t->wall_mu_r[w], "-", t->wall_mu_r_range[w]};
         snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
     }
     return n;
@@ -50,10 +53,22 @@ static int write_table_csv(const char *dir, const row *rows, int n, char *err, s
     snprintf(path, sizeof path, "%s/calibrated_parameters.csv", dir);
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
-    fputs("contact,material,parameter,value,unit\n", a.f);
-    for (int i = 0; i < n; ++i)
-        fprintf(a.f, "%s,%s,%s,%.6g,%s\n", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
+    // identified_min/max: the range of the candidates the data cannot tell
+    // apart (cal_friction_identify); empty where nothing was calibrated.
+    fputs("contact,material,parameter,value,unit,identified_min,identified_max\n", a.f);
+    for (int i = 0; i < n; ++i) {
+        fprintf(a.f, "%s,%s,%s,%.6g,%s,", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
+        if (isfinite(rows[i].range.lo)) fprintf(a.f, "%.6g,%.6g\n", rows[i].range.lo, rows[i].range.hi);
+        else fputs(",\n", a.f);
+    }
     return cal_atomic_commit(&a, err, len);
+}
+
+static const char *range_cell(char out[48], cal_range g)
+{
+    if (isfinite(g.lo)) snprintf(out, 48, "%.3g – %.3g", g.lo, g.hi);
+    else out[0] = '\0';
+    return out;
 }
 
 static int write_table_md(const char *dir, const cal_table *t, char *err, size_t len)
@@ -63,24 +78,27 @@ static int write_table_md(const char *dir, const cal_table *t, char *err, size_t
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
-    fputs("| Contact | Parameter | Material | Value | Source |\n|---|---|---|---|---|\n", f);
-    fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | config |\n", t->density);
-    fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | %s |\n", t->k_n, t->k_source);
-    fprintf(f, "| | Damping ratio ξ | | %g | config |\n", t->xi);
-    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s |\n", t->gg_mu_s, t->gg_source);
-    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s |\n", t->gg_mu_r, t->gg_source);
-    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | 2 k_n, springs in series (Table 3) |\n", 2 * t->k_n);
-    fprintf(f, "| | Damping ratio ξ | | %g | config |\n", t->xi);
+    char g[2][48];
+    fputs("| Contact | Parameter | Material | Value | Identified range (95 %) | Source |\n|---|---|---|---|---|---|\n", f);
+    fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | | config |\n", t->density);
+    fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | | %s |\n", t->k_n, t->k_source);
+    fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
+    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s | %s |\n", t->gg_mu_s, range_cell(g[0], t->gg_mu_s_range), t->gg_source);
+    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s | %s |\n", t->gg_mu_r, range_cell(g[1], t->gg_mu_r_range), t->gg_source);
+    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | | 2 k_n, springs in series (Table 3) |\n", 2 * t->k_n);
+    fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
     for (int w = 0; w < t->n_walls; ++w)
-        fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s |\n", t->wall_name[w], t->wall_mu_s[w], t->wall_source[w]);
+        fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_s[w],
+                range_cell(g[0], t->wall_mu_s_range[w]), t->wall_source[w]);
     for (int w = 0; w < t->n_walls; ++w)
-        fprintf(f, "| | Rolling friction μr,g-s | %s | %.3g | %s |\n", t->wall_name[w], t->wall_mu_r[w], t->wall_source[w]);
+        fprintf(f, "| | Rolling friction μr,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_r[w],
+                range_cell(g[1], t->wall_mu_r_range[w]), t->wall_source[w]);
     return cal_atomic_commit(&a, err, len);
 }
 
 typedef struct h5_row {
     char contact[24], material[32], parameter[16], unit[8];
-    double value;
+    double value, identified_min, identified_max; ///< NaN: not calibrated
 } h5_row;
 
 static int write_table_h5(const char *dir, const row *rows, int n, char *err, size_t len)
@@ -96,6 +114,7 @@ static int write_table_h5(const char *dir, const row *rows, int n, char *err, si
         snprintf(data[i].parameter, sizeof data[i].parameter, "%s", rows[i].parameter);
         snprintf(data[i].unit, sizeof data[i].unit, "%s", rows[i].unit);
         data[i].value = rows[i].value;
+        data[i].identified_min = rows[i].range.lo, data[i].identified_max = rows[i].range.hi;
     }
     hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     hid_t type = H5Tcreate(H5T_COMPOUND, sizeof(h5_row));
@@ -110,6 +129,8 @@ static int write_table_h5(const char *dir, const row *rows, int n, char *err, si
         H5Tinsert(type, names[k], offsets[k], strings[k]);
     }
     H5Tinsert(type, "value", offsetof(h5_row, value), H5T_NATIVE_DOUBLE);
+    H5Tinsert(type, "identified_min", offsetof(h5_row, identified_min), H5T_NATIVE_DOUBLE);
+    H5Tinsert(type, "identified_max", offsetof(h5_row, identified_max), H5T_NATIVE_DOUBLE);
     hsize_t dims[1] = {(hsize_t)n};
     hid_t space = H5Screate_simple(1, dims, NULL);
     hid_t set = file >= 0 ? H5Dcreate2(file, "calibrated_parameters", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
@@ -326,7 +347,51 @@ static int plot_friction(const char *dir, const cal_outcome *o, const cal_fricti
 
 // ---- report -------------------------------------------------------------------------
 
-static void report_friction(FILE *f, const cal_friction_result *r)
+// One end of an identified range: at the search bound, bracketed by an
+// excluded candidate, or open (nothing evaluated beyond it).
+static void range_end(FILE *f, const char *side, double end, double beyond, double bound)
+{
+    if (fabs(end - bound) <= 1e-9 * fabs(bound))
+        fprintf(f, "reaches the search's %s bound (the data do not bound it there)", side);
+    else if (isfinite(beyond))
+        fprintf(f, "%s end between %.3g and the excluded %.3g", side, end, beyond);
+    else fprintf(f, "%s end not bracketed (nothing evaluated beyond %.3g)", side, end);
+}
+
+static void report_range(FILE *f, const char *name, cal_range g, double lo_bound, double hi_bound)
+{
+    fprintf(f, "- %s from %.4g to %.4g: ", name, g.lo, g.hi);
+    range_end(f, "lower", g.lo, g.below, lo_bound);
+    fputs("; ", f);
+    range_end(f, "upper", g.hi, g.above, hi_bound);
+    fputs(".\n", f);
+}
+
+static void report_identified(FILE *f, const cal_friction_result *r, const cal_bounds *b)
+{
+    int tier_sd = 0;
+    for (int j = 0; j < r->n_rpm; ++j) tier_sd |= r->csa_tier_sd[j] > 0;
+    fprintf(f, "\nWhat the data identify: every candidate's χ² over the angle (by its tolerance) and the CSA speeds "
+               "(by the lab's spread%s); the candidates within Δχ² = %.2f of the least (one parameter's 95 %% "
+               "interval) are ones these measurements cannot tell from the best (%d of %d):\n\n",
+            tier_sd ? " and this tier's measured seed spread, in quadrature" : " only: this tier's seed spread is not "
+                      "measured (csa_sd_percent), so the ranges are too narrow",
+            r->chi2_threshold, r->identified_count, r->n);
+    fputs("| candidate | from | μs | μr | angle (°) | χ² | Δχ² | told apart |\n|---|---|---|---|---|---|---|---|\n", f);
+    double least = INFINITY;
+    for (int i = 0; i < r->n; ++i) least = fmin(least, r->cand[i].chi2);
+    for (int i = 0; i < r->n; ++i) {
+        const cal_candidate *k = &r->cand[i];
+        fprintf(f, "| %d | %s | %.4g | %.4g | %.2f | %.3g | %.3g | %s |\n", i + 1, k->origin ? k->origin : "", k->mu_s,
+                k->mu_r, k->angle_deg, k->chi2, k->chi2 - least, k->identified ? "no" : "yes");
+    }
+    fputc('\n', f);
+    if (!isfinite(r->mu_s_range.lo)) return;
+    report_range(f, "μs", r->mu_s_range, b->mu_s_min, b->mu_s_max);
+    report_range(f, "μr", r->mu_r_range, b->mu_r_min, b->mu_r_max);
+}
+
+static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds)
 {
     const char *stage = r->material[0] ? r->material : "granule-granule";
     fprintf(f, "\n## %s (surface '%s' in the data)\n\n", stage, r->surface);
@@ -364,6 +429,7 @@ static void report_friction(FILE *f, const cal_friction_result *r)
     for (int j = 0; r->best >= 0 && j < r->n_rpm; ++j)
         fprintf(f, "| %g | %.2f ± %.2f | %.2f ± %.2f | %s |\n", r->rpm[j], r->csa_data[j], r->csa_data_sd[j],
                 r->cand[r->best].csa[j], r->cand[r->best].csa_sd[j], r->cand[r->best].usable[j] ? "yes" : "no");
+    report_identified(f, r, bounds);
 }
 
 static int write_report(const char *dir, const cal_outcome *o, char *err, size_t len)
@@ -401,8 +467,8 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
                        "finer cylinder (smaller cylinder_lambda: more layers, more pressure) resolves it.\n",
                     s->k[0], o->config->k_n);
     }
-    if (o->granule) report_friction(f, o->granule);
-    for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w]);
+    if (o->granule) report_friction(f, o->granule, &o->config->granule);
+    for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w], &o->config->wall);
     return cal_atomic_commit(&a, err, len);
 }
 

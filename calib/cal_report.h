@@ -14,10 +14,12 @@ typedef struct cal_table {
     double density, xi, k_n;
     const char *k_source;
     double gg_mu_s, gg_mu_r;
+    cal_range gg_mu_s_range, gg_mu_r_range; ///< identified ranges; NAN where the stage was not run
     const char *gg_source;
     int n_walls;
     char wall_name[16][32];
     double wall_mu_s[16], wall_mu_r[16];
+    cal_range wall_mu_s_range[16], wall_mu_r_range[16];
     char wall_source[16][96];
 } cal_table;
 

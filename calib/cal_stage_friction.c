@@ -13,7 +13,12 @@
 // comes first: it maps the angle over the plane (Fig. 13, 17), shows the
 // ambiguity (every pair matching the angle) and starts COBYLA from its best
 // point. Every candidate uses the same seed and therefore the same settled
-// bed procedure, so the objective is deterministic.
+// bed procedure, so the objective is deterministic. After the search, two
+// bound probes (the best μs at μr's search bounds) and the identified ranges:
+// where the drum cannot tell μr apart (a wall's μr below ~0.03 at the ci
+// tier, results/table3_ci/wall_mu_r_response/), the table says over what
+// range, not just which point noise picked.
+#include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <nlopt.h>
 #include <stdio.h>
@@ -90,7 +95,8 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
 // "candidate i of at most N", with the time left at the pace so far.
 static void show_start(const search *s, double mu_s, double mu_r)
 {
-    int planned = s->t->grid * s->t->grid + s->t->max_evaluations, done = s->r->n;
+    int probes = cal_tier_bound_probes(s->t) ? 2 : 0;
+    int planned = s->t->grid * s->t->grid + s->t->max_evaluations + probes, done = s->r->n;
     double spent = exp_wall_seconds() - s->started;
     char eta[48] = "";
     if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
@@ -98,13 +104,13 @@ static void show_start(const search *s, double mu_s, double mu_r)
             s->env->stage, done + 1, planned, mu_s, mu_r, s->n_sim, eta, s->env->tty ? "" : "\n");
 }
 
-static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
+static int same_value(double a, double b) { return fabs(a - b) <= 1e-12 * fmax(fabs(a), fabs(b)); }
+
+static cal_candidate *evaluate(search *s, double mu_s, double mu_r, const char *origin)
 {
     cal_friction_result *r = s->r;
-    const cal_bounds *b = bounds_of(s);
-    double mu_s = to_mu_s(b, u), mu_r = to_mu_r(b, v);
-    for (int i = 0; i < r->n; ++i) // a point seen before (COBYLA revisits): no new simulation
-        if (r->cand[i].mu_s == mu_s && r->cand[i].mu_r == mu_r) return &r->cand[i];
+    for (int i = 0; i < r->n; ++i) // a point seen before (COBYLA revisits, a probe at a grid point): no new simulation
+        if (same_value(r->cand[i].mu_s, mu_s) && same_value(r->cand[i].mu_r, mu_r)) return &r->cand[i];
     if (r->n >= CAL_MAX_EVALS || s->failed) return NULL;
     cal_drum_case dc = s->material ? cal_drum_case_wall(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
                                    : cal_drum_case_granule(s->c, s->t, r->k_n, mu_s, mu_r);
@@ -117,7 +123,7 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     }
     cal_candidate *k = &r->cand[r->n++];
     memset(k, 0, sizeof *k);
-    k->mu_s = mu_s, k->mu_r = mu_r, k->from_grid = from_grid;
+    k->mu_s = mu_s, k->mu_r = mu_r, k->origin = origin;
     score(s, k, rec);
     for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
         k->wall_time_s += rec[i].wall_time_s + rec[i].fill_wall_time_s, cal_record_free(&rec[i]);
@@ -130,11 +136,18 @@ static cal_candidate *evaluate(search *s, double u, double v, int from_grid)
     return k;
 }
 
+// COBYLA's point of the unit square (μs linear, log10 μr).
+static cal_candidate *evaluate_unit(search *s, const double *x, const char *origin)
+{
+    const cal_bounds *b = bounds_of(s);
+    return evaluate(s, to_mu_s(b, x[0]), to_mu_r(b, x[1]), origin);
+}
+
 static double objective(unsigned n, const double *x, double *grad, void *ctx)
 {
     (void)n, (void)grad;
     search *s = ctx;
-    cal_candidate *k = evaluate(s, x[0], x[1], 0);
+    cal_candidate *k = evaluate_unit(s, x, "COBYLA");
     if (!k) return nlopt_force_stop(s->opt), HUGE_VAL;
     return k->objective;
 }
@@ -143,7 +156,7 @@ static double angle_constraint(unsigned n, const double *x, double *grad, void *
 {
     (void)n, (void)grad;
     search *s = ctx;
-    cal_candidate *k = evaluate(s, x[0], x[1], 0); // the same point as the objective: from the list
+    cal_candidate *k = evaluate_unit(s, x, "COBYLA"); // the same point as the objective: from the list
     return k ? k->angle_violation : 0;
 }
 
@@ -163,6 +176,56 @@ int cal_friction_best(const cal_friction_result *r)
     for (int i = 0; i < r->n; ++i)
         if (isfinite(r->cand[i].angle_deg) && (best < 0 || better(r, &r->cand[i], &r->cand[best]))) best = i;
     return best;
+}
+
+// ---- what the data identify ----------------------------------------------------
+
+// χ² against every measurement, each by its whole spread: the angle by its
+// tolerance (lab and tier), each CSA speed by the lab's and the tier's
+// spreads in quadrature.
+static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
+{
+    double z = (k->angle_deg - r->angle_target) / fmax(r->angle_tolerance, min_angle_sd);
+    double sum = isfinite(z) ? z * z : failed_speed_penalty;
+    for (int i = 0; i < r->n_rpm; ++i) {
+        double lab = fmax(r->csa_data_sd[i], min_csa_sd), tier = r->csa_tier_sd[i];
+        double zc = (k->csa[i] - r->csa_data[i]) / sqrt(lab * lab + tier * tier);
+        sum += k->usable[i] ? zc * zc : failed_speed_penalty;
+    }
+    return sum;
+}
+
+// μs (rolling = 0) or μr over the identified candidates, and the nearest
+// excluded value beyond each end.
+static cal_range range_of(const cal_friction_result *r, int rolling)
+{
+    cal_range g = {INFINITY, -INFINITY, NAN, NAN};
+    for (int i = 0; i < r->n; ++i)
+        if (r->cand[i].identified) {
+            double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
+            g.lo = fmin(g.lo, v), g.hi = fmax(g.hi, v);
+        }
+    if (!(g.lo <= g.hi)) return (cal_range){NAN, NAN, NAN, NAN};
+    for (int i = 0; i < r->n; ++i) {
+        double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
+        if (r->cand[i].identified) continue;
+        if (v < g.lo && !(v <= g.below)) g.below = v; // the largest value below
+        if (v > g.hi && !(v >= g.above)) g.above = v; // the smallest above
+    }
+    return g;
+}
+
+void cal_friction_identify(cal_friction_result *r)
+{
+    r->chi2_threshold = gsl_cdf_chisq_Qinv(0.05, 1); // 3.84
+    double least = INFINITY;
+    for (int i = 0; i < r->n; ++i) r->cand[i].chi2 = chi2_of(r, &r->cand[i]), least = fmin(least, r->cand[i].chi2);
+    r->identified_count = 0;
+    for (int i = 0; i < r->n; ++i) {
+        r->cand[i].identified = r->cand[i].chi2 - least <= r->chi2_threshold;
+        r->identified_count += r->cand[i].identified;
+    }
+    r->mu_s_range = range_of(r, 0), r->mu_r_range = range_of(r, 1);
 }
 
 static void unit_coordinates(const search *s, const cal_candidate *k, double *u, double *v)
@@ -197,6 +260,26 @@ static const char *run_cobyla(search *s)
     }
 }
 
+// After the search, the best μs with μr at each search bound: whether the
+// data bound μr on each side, or the identified range reaches the bound.
+static void probe_bounds(search *s)
+{
+    int best = cal_friction_best(s->r);
+    if (best < 0) return;
+    const cal_bounds *b = bounds_of(s);
+    double mu_s = s->r->cand[best].mu_s;
+    if (!s->failed) evaluate(s, mu_s, b->mu_r_min, "bound probe");
+    if (!s->failed) evaluate(s, mu_s, b->mu_r_max, "bound probe");
+}
+
+// Where a speed is in the tier's rpm list (0 when the tier takes every speed).
+static unsigned tier_index_of(const cal_tier *t, double rpm)
+{
+    for (unsigned j = 0; j < t->rpm_count; ++j)
+        if (t->rpm[j] == rpm) return j;
+    return 0;
+}
+
 // The speeds to simulate, the targets and tolerances, from the data files.
 static int set_targets(search *s, const cal_series *angles, const cal_series *areas)
 {
@@ -218,6 +301,7 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
         if (!wanted) continue;
         if (r->n_rpm == CAL_MAX_RPM) return exp_fail(s->err, s->len, "at most %d speeds", CAL_MAX_RPM);
         r->rpm[r->n_rpm] = pts[i]->rpm, r->csa_data[r->n_rpm] = pts[i]->value, r->csa_data_sd[r->n_rpm] = pts[i]->sd;
+        r->csa_tier_sd[r->n_rpm] = cal_tier_csa_sd(s->t, tier_index_of(s->t, pts[i]->rpm));
         s->sim_rpm[s->n_sim++] = pts[i]->rpm;
         r->n_rpm++;
     }
@@ -245,9 +329,12 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
     if (set_targets(&s, angles, areas)) return 1;
     for (int i = 0; i < t->grid && !s.failed; ++i)
-        for (int j = 0; j < t->grid && !s.failed; ++j) evaluate(&s, (i + 0.5) / t->grid, (j + 0.5) / t->grid, 1);
+        for (int j = 0; j < t->grid && !s.failed; ++j)
+            evaluate_unit(&s, (const double[2]){(i + 0.5) / t->grid, (j + 0.5) / t->grid}, "grid");
     out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
+    if (cal_tier_bound_probes(t)) probe_bounds(&s);
     out->best = cal_friction_best(out);
+    cal_friction_identify(out);
     out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
     out->wall_time_s = exp_wall_seconds() - t0;
     if (s.failed) return 1;

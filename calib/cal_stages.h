@@ -46,9 +46,17 @@ typedef struct cal_candidate {
     double angle_violation;             ///< |angle - target| - tolerance (≤ 0: matches)
     double objective;                   ///< what the search minimises: the CSA misfit, or with the
                                         ///< angle's squared z-score as one more term (angle_in_misfit)
-    int from_grid;
+    const char *origin;                 ///< "grid", "COBYLA" or "bound probe"
+    double chi2;                        ///< χ² against the data with the lab's and the tier's spreads (identification)
+    int identified;                     ///< 1 if the data cannot tell it from the best χ² (Δχ² within the threshold)
     double wall_time_s;
 } cal_candidate;
+
+/// The range of one parameter over the candidates the data cannot tell apart.
+typedef struct cal_range {
+    double lo, hi;       ///< smallest and largest value among them
+    double below, above; ///< the nearest excluded candidate's value beyond each end; NAN: none evaluated there
+} cal_range;
 
 /// What a friction stage found.
 typedef struct cal_friction_result {
@@ -61,10 +69,14 @@ typedef struct cal_friction_result {
     int angle_in_misfit;                             ///< the tier's angle_rule is "misfit"
     int n_rpm;
     double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
+    double csa_tier_sd[CAL_MAX_RPM];    ///< the tier's measured seed spread at each speed (0: not measured)
     int n;                              ///< candidates evaluated
     cal_candidate cand[CAL_MAX_EVALS];
     int best;                           ///< index of the chosen candidate, -1 if none usable
     int best_feasible;                  ///< 1 if it matches the angle
+    double chi2_threshold;              ///< Δχ² within which candidates are not told apart
+    cal_range mu_s_range, mu_r_range;   ///< what the data identify (cal_friction_identify)
+    int identified_count;               ///< candidates within the threshold
     const char *nlopt_result;
     double wall_time_s;
 } cal_friction_result;
@@ -75,6 +87,15 @@ typedef struct cal_friction_result {
 void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
 /// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
 int cal_friction_best(const cal_friction_result *r);
+
+/// The identified ranges (README "Identified ranges"): each candidate's χ²
+/// against every measurement (the angle by its tolerance, each CSA speed by
+/// the lab's and the tier's spreads combined; a failed measurement counts
+/// as 5 standard deviations), then every candidate whose χ² is within
+/// Δχ² = 3.84 of the smallest (one parameter's 95 % confidence interval,
+/// the χ² distribution with 1 degree of freedom) is one the data cannot
+/// tell from the best; μs and μr range over those. Needs csa_tier_sd set.
+void cal_friction_identify(cal_friction_result *r);
 
 /// Stage 2 (material == NULL) or 3 (a material of the config).
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,

@@ -383,6 +383,62 @@ static void test_friction_rule(void **state)
     assert_true(fabs(r.cand[0].objective - (25 + 2 * 27.8 + 25) / 4) < 1e-9);
 }
 
+// The identified ranges (cal_friction_identify). First by hand: one speed,
+// lab spread 0.6 and tier spread 0.8 (quadrature: 1.0), angle 40 ± 2. A fits
+// exactly (χ² 0); B is 1 tolerance off the angle and 1.5 spreads off the CSA
+// (χ² 3.25: not told apart; by the lab's spread alone it would be 7.25); C is
+// 2 spreads off the CSA (χ² 4 > 3.84: told apart).
+static void test_identified_ranges(void **state)
+{
+    (void)state;
+    static cal_friction_result r;
+    memset(&r, 0, sizeof r);
+    r.angle_target = 40, r.angle_tolerance = 2, r.n_rpm = 1, r.n = 3;
+    r.csa_data[0] = 50, r.csa_data_sd[0] = 0.6, r.csa_tier_sd[0] = 0.8;
+    const double mu_s[3] = {0.5, 0.6, 0.7}, mu_r[3] = {0.01, 0.001, 0.1}, angle[3] = {40, 42, 40}, csa[3] = {50, 51.5, 52};
+    for (int k = 0; k < 3; ++k) {
+        cal_candidate *c = &r.cand[k];
+        c->mu_s = mu_s[k], c->mu_r = mu_r[k], c->angle_deg = angle[k], c->csa[0] = csa[k], c->usable[0] = 1;
+    }
+    cal_friction_identify(&r);
+    assert_true(fabs(r.chi2_threshold - 3.841458820694124) < 1e-9); // χ²(1 dof) at 95 %
+    assert_true(fabs(r.cand[1].chi2 - 3.25) < 1e-9 && fabs(r.cand[2].chi2 - 4) < 1e-9);
+    assert_int_equal(r.identified_count, 2);
+    assert_true(r.cand[0].identified && r.cand[1].identified && !r.cand[2].identified);
+    assert_true(r.mu_s_range.lo == 0.5 && r.mu_s_range.hi == 0.6 && isnan(r.mu_s_range.below) && r.mu_s_range.above == 0.7);
+    assert_true(r.mu_r_range.lo == 0.001 && r.mu_r_range.hi == 0.01 && isnan(r.mu_r_range.below) && r.mu_r_range.above == 0.1);
+    // A failed speed counts as 5 spreads: C with its CSA lost is told apart.
+    r.cand[2].usable[0] = 0;
+    cal_friction_identify(&r);
+    assert_true(fabs(r.cand[2].chi2 - 25) < 1e-9);
+
+    // Then the five PP candidates of the ci run (results/table3_ci/r3_misfit/
+    // simulations.csv; target 39.80 ± 2.75° at 4 rpm; PP's data at 4, 40 and
+    // 116 rpm; the ci tier's seed spreads 0.55, 0.81, 1.37). The wall μr of
+    // 1.5e-4 and 0.033 at μs 0.775 both stay within the threshold of the best:
+    // μr is identified only as a range; μs 0.325 is told apart.
+    memset(&r, 0, sizeof r);
+    r.angle_target = 39.80, r.angle_tolerance = 2.75, r.n_rpm = 3, r.n = 5;
+    const double data[3] = {43.52, 49.78, 57.24}, lab[3] = {0.47, 0.73, 2.03}, tier[3] = {0.55, 0.81, 1.37};
+    for (int i = 0; i < 3; ++i) r.csa_data[i] = data[i], r.csa_data_sd[i] = lab[i], r.csa_tier_sd[i] = tier[i];
+    const double pp[5][6] = {{0.325, 0.000149535, 40.2781, 43.6714, 45.3576, 47.3974},
+                             {0.325, 0.033437, 37.1122, 42.6458, 46.0329, 47.5081},
+                             {0.775, 0.000149535, 40.1157, 43.3341, 47.5945, 55.1279},
+                             {0.775, 0.033437, 38.5819, 43.7659, 47.6825, 56.0256},
+                             {1, 0.033437, 40.5834, 43.1362, 48.1761, 56.3319}};
+    for (int k = 0; k < 5; ++k) {
+        cal_candidate *c = &r.cand[k];
+        c->mu_s = pp[k][0], c->mu_r = pp[k][1], c->angle_deg = pp[k][2];
+        for (int i = 0; i < 3; ++i) c->csa[i] = pp[k][3 + i], c->usable[i] = 1;
+    }
+    cal_friction_identify(&r);
+    for (int k = 0; k < 5; ++k) printf("PP candidate %d: chi2 %.3g%s\n", k + 1, r.cand[k].chi2, r.cand[k].identified ? " (identified)" : "");
+    assert_true(!r.cand[0].identified && !r.cand[1].identified);
+    assert_true(r.cand[2].identified && r.cand[3].identified && r.cand[4].identified);
+    assert_true(r.mu_s_range.lo == 0.775 && r.mu_s_range.hi == 1 && r.mu_s_range.below == 0.325);
+    assert_true(r.mu_r_range.lo == 0.000149535 && r.mu_r_range.hi == 0.033437);
+}
+
 int main(void)
 {
     const char *s = getenv("GRANUCAL_SOURCE_DIR");
@@ -398,6 +454,7 @@ int main(void)
         cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
         cmocka_unit_test(test_stiffness_rule),
         cmocka_unit_test(test_friction_rule),
+        cmocka_unit_test(test_identified_ranges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
