@@ -35,6 +35,11 @@ static const char help[] =
     "     angle of repose matching the lab's (a tier with `angle_rule: misfit` puts the\n"
     "     angle into the misfit instead, for runs whose angle is as noisy as the band);\n"
     "  3. each wall material's (mu_s, mu_r), granule-granule frozen, the same way.\n"
+    "After each search, the best mu_s is run at mu_r's two search bounds, and every\n"
+    "candidate's chi^2 (angle and CSA, by the lab's and the tier's measured spreads)\n"
+    "gives the identified range: the candidates within Delta chi^2 = 3.84 of the best,\n"
+    "which these measurements cannot tell apart. A wall mu_r the drum does not resolve\n"
+    "shows as a range that reaches the search bound, not as one noisy point.\n"
     "\n"
     "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
     "(repose_angle.csv: surface,rpm,angle_deg,angle_sd_deg; occupied_area.csv:\n"
@@ -55,7 +60,8 @@ static const char help[] =
     "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
     "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
     "\n"
-    "Outputs in OUT: calibrated_parameters.{csv,md,h5}, simulations.csv, report.md,\n"
+    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max),\n"
+    "simulations.csv, report.md (every candidate, its chi^2, the ranges),\n"
     "cn_vs_k.png, angle_map_*.png, csa_vs_rpm_*.png, convergence_*.png,\n"
     "liggghts_parameters.in, lammps_parameters.in.\n";
 

@@ -22,6 +22,9 @@ static const cyaml_schema_field_t material_fields[] = {
     CYAML_FIELD_STRING_PTR("surface", CYAML_FLAG_POINTER, cal_material, surface, 1, 47), CYAML_FIELD_END};
 static const cyaml_schema_value_t material_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_material, material_fields)};
 
+// A strict yes/no: libcyaml's bool reads any word but a few as true.
+static const cyaml_strval_t yes_no[] = {{"false", 0}, {"true", 1}, {"no", 0}, {"yes", 1}};
+
 #define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
 static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_tier, name, 1, 31),
@@ -42,7 +45,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
     CYAML_FIELD_SEQUENCE("csa_sd_percent", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, csa_sd_percent,
                          &float_entry, 1, 32),
-    CYAML_FIELD_BOOL("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, bound_probes),
+    CYAML_FIELD_ENUM("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER | CYAML_FLAG_STRICT, cal_tier, bound_probes,
+                     yes_no, CYAML_ARRAY_LEN(yes_no)),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 

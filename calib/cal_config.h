@@ -7,7 +7,6 @@
 #ifndef CAL_CONFIG_H
 #define CAL_CONFIG_H
 
-#include <stdbool.h>
 #include <stddef.h>
 
 /// A wall material to fit: its name in the table and its drum lining's name
@@ -57,7 +56,7 @@ typedef struct cal_tier {
     unsigned csa_sd_percent_count;
     /// After the search, the best μs with μr at each search bound, so that the
     /// identified μr range says whether the data bound it (absent: true).
-    bool *bound_probes;
+    int *bound_probes;
 } cal_tier;
 
 /// 1 if the tier puts the angle into the misfit instead of a constraint.

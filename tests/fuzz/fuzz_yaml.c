@@ -65,6 +65,11 @@ static void check_config(const cal_config *c, const char *path)
         finite(L, "tier angle_offset_deg", t->angle_offset_deg);
         if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
             fuzz_violation("cal_config_load accepted an unknown angle_rule", t->angle_rule);
+        if (t->csa_sd_percent_count > 1 && t->csa_sd_percent_count != t->rpm_count)
+            fuzz_violation("cal_config_load accepted csa_sd_percent not one per speed", NULL);
+        for (unsigned j = 0; j < t->csa_sd_percent_count; ++j)
+            if (!(t->csa_sd_percent[j] >= 0 && t->csa_sd_percent[j] < 50))
+                fuzz_violation("cal_config_load accepted a csa_sd_percent outside [0, 50)", NULL);
     }
     if (c->fidelity) {
         const cal_fidelity *f = c->fidelity;
