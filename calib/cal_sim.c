@@ -135,16 +135,34 @@ static int read_back(const cal_env *env, const char *key, cal_record *out, char 
 
 // ---- drum -----------------------------------------------------------------
 
+/// One drum run: a candidate (index into the batch's cases) at one speed.
+typedef struct drum_run {
+    int c, k;
+} drum_run;
+
+// The missing runs of several candidates. When they all settle the same bed
+// (the wall stage's candidates, or one candidate) it is settled once, here,
+// and each run is a task: its speeds turn side by side. Otherwise (the
+// granule stage's candidates each settle their own bed) each candidate is a
+// task that settles its bed and turns its speeds in turn, so that one
+// candidate's settling overlaps another's turning instead of leaving the
+// other workers idle.
 typedef struct drum_batch {
     cal_env *env;
-    const cal_drum_case *c;
-    dem_world *bed;
-    double bed_wall_s;
+    const cal_drum_case *cases;
+    int n_cases;
     const double *rpm;
-    int *todo;             ///< indices into rpm of this rank's missing runs
-    char keys[32][2048];
-    char err[512];
+    int n_rpm;
+    char (*keys)[2048];    ///< [c * n_rpm + k]
+    drum_run *todo;        ///< this rank's missing runs
+    int n_todo;
+    int *case_todo;        ///< own-bed tasks: this rank's candidates with missing runs
+    int n_case_todo;
+    dem_world *bed;        ///< the shared bed (shared_fill)
+    double bed_wall_s;
 } drum_batch;
+
+static const char *run_key(const drum_batch *b, drum_run r) { return b->keys[r.c * b->n_rpm + r.k]; }
 
 static int write_failed_record(const cal_env *env, const char *key, const char *reason, int retry)
 {
@@ -166,48 +184,76 @@ static int killed_from_outside(int sig)
     return sig == SIGKILL || sig == SIGTERM || sig == SIGINT || sig == SIGHUP || sig == SIGQUIT;
 }
 
-static int turn_one(int i, void *ctx)
+// Turn `bed` (this process's own, or a clone when inline) at run r's speed and
+// store the record; fill_s: the settling's wall time, charged to this run.
+static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill_s)
 {
-    drum_batch *b = ctx;
-    int k = b->todo[i];
-    exp_drum_run_opts run = b->c->run;
-    run.rpm = b->rpm[k];
-    // In a forked child the bed is this process's own copy; inline, turn a clone.
-    dem_world *w = b->env->use_fork ? b->bed : dem_world_clone(b->bed);
-    if (!w) return write_failed(b->env, b->keys[k], "out of memory copying the settled bed"), 1;
+    const cal_drum_case *c = &b->cases[r.c];
+    const char *key = run_key(b, r);
+    exp_drum_run_opts run = c->run;
+    run.rpm = b->rpm[r.k];
+    dem_world *w = b->env->use_fork ? bed : dem_world_clone(bed);
+    if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
     double t0 = exp_wall_seconds();
     exp_drum_result res;
-    dem_status st = exp_drum_rotate(w, &b->c->def, &run, NULL, NULL, &res);
-    cal_record r = {.key = b->keys[k], .reason = ""};
-    r.status = st != DEM_OK ? "failed" : res.steady ? "ok" : "not steady";
-    if (st != DEM_OK) r.reason = (char *)dem_world_error(w);
-    r.angle_deg = res.angle_deg, r.angle_sd_deg = res.angle_sd_deg;
-    r.csa_percent = res.csa_percent, r.csa_sd_percent = res.csa_sd_percent;
-    r.steady = res.steady, r.simulated_time_s = res.simulated_time_s;
-    r.wall_time_s = exp_wall_seconds() - t0;
-    r.fill_wall_time_s = i == 0 ? b->bed_wall_s : 0; // a bed settled now is charged once, to its first speed
-    r.peak_rss_mb = exp_peak_rss_mb();
-    r.dt_s = dem_world_dt(w), r.particle_steps = (double)res.particle_steps, r.granules = (int)res.granules;
+    dem_status st = exp_drum_rotate(w, &c->def, &run, NULL, NULL, &res);
+    cal_record rec = {.key = (char *)key, .reason = ""};
+    rec.status = st != DEM_OK ? "failed" : res.steady ? "ok" : "not steady";
+    if (st != DEM_OK) rec.reason = (char *)dem_world_error(w);
+    rec.angle_deg = res.angle_deg, rec.angle_sd_deg = res.angle_sd_deg;
+    rec.csa_percent = res.csa_percent, rec.csa_sd_percent = res.csa_sd_percent;
+    rec.steady = res.steady, rec.simulated_time_s = res.simulated_time_s;
+    rec.wall_time_s = exp_wall_seconds() - t0;
+    rec.fill_wall_time_s = fill_s;
+    rec.peak_rss_mb = exp_peak_rss_mb();
+    rec.dt_s = dem_world_dt(w), rec.particle_steps = (double)res.particle_steps, rec.granules = (int)res.granules;
     char err[512];
-    int bad = cal_store_put(b->env->store, &r, err, sizeof err);
+    int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
     if (!b->env->use_fork) dem_world_destroy(w);
     return bad;
 }
 
-// A worker ended: a process killed by a signal wrote nothing, so record it
-// as failed; then show what the record holds.
-static void finish_task(cal_env *env, const char *key, const char *what, int code)
+// Shared bed: task i is run todo[i]; a bed settled now is charged once, to the first.
+static int turn_one(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    return turn_and_store(b, b->bed, b->todo[i], i == 0 ? b->bed_wall_s : 0);
+}
+
+// Own bed: task i settles candidate case_todo[i]'s bed and turns its missing speeds.
+static int settle_and_turn(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    int c = b->case_todo[i], bad = 0;
+    char err[1024];
+    double t0 = exp_wall_seconds();
+    dem_world *bed = exp_drum_fill(&b->cases[c].fill, NULL, NULL, err, sizeof err);
+    double fill_s = exp_wall_seconds() - t0;
+    for (int j = 0; j < b->n_todo; ++j) {
+        if (b->todo[j].c != c) continue;
+        if (!bed) bad |= write_failed(b->env, run_key(b, b->todo[j]), err);
+        else bad |= turn_and_store(b, bed, b->todo[j], fill_s), fill_s = 0;
+    }
+    dem_world_destroy(bed);
+    return bad;
+}
+
+// A run ended: a process killed by a signal wrote nothing, so record it as
+// failed (unless its record was stored before); then show what it holds.
+static void finish_run(cal_env *env, const char *key, const char *what, int code)
 {
     char err[512];
-    if (code < 0) {
+    cal_record r;
+    int got = cal_store_get(env->store, key, &r, err, sizeof err);
+    if (got == 0) cal_record_free(&r);
+    if (code < 0 && got != 0) {
         char reason[96];
         int outside = killed_from_outside(-code);
         snprintf(reason, sizeof reason, "the simulation process died (signal %d%s)", -code,
                  outside ? ", killed from outside: a later run retries it" : "");
         write_failed_record(env, key, reason, outside);
     }
-    cal_record r;
     if (cal_store_get(env->store, key, &r, err, sizeof err) == 0) {
         show_done(env, what, &r);
         cal_record_free(&r);
@@ -215,13 +261,26 @@ static void finish_task(cal_env *env, const char *key, const char *what, int cod
     env->simulations_run++;
 }
 
+static void show_run(drum_batch *b, drum_run r, int code, int n_cases)
+{
+    char what[96];
+    const dem_contact_params *p = &b->cases[r.c].def.wall; // the granule stage's wall pair is its granule pair
+    if (n_cases > 1) snprintf(what, sizeof what, "mu_s = %.4g, mu_r = %.4g, %g rpm", p->mu_s, p->mu_r, b->rpm[r.k]);
+    else snprintf(what, sizeof what, "%g rpm", b->rpm[r.k]);
+    finish_run(b->env, run_key(b, r), what, code);
+}
+
 static void turned(int i, int code, void *ctx)
 {
     drum_batch *b = ctx;
-    int k = b->todo[i];
-    char what[64];
-    snprintf(what, sizeof what, "%g rpm", b->rpm[k]);
-    finish_task(b->env, b->keys[k], what, code);
+    show_run(b, b->todo[i], code, b->n_cases);
+}
+
+static void settled_and_turned(int i, int code, void *ctx)
+{
+    drum_batch *b = ctx;
+    for (int j = 0; j < b->n_todo; ++j)
+        if (b->todo[j].c == b->case_todo[i]) show_run(b, b->todo[j], code, b->n_cases);
 }
 
 // The last settled bed and what defined it: the wall stage's candidates all
@@ -255,41 +314,77 @@ static dem_world *settled_bed(const exp_drum_def *fill, double *wall_s, char *er
     return kept.bed;
 }
 
-// Settle (or reuse) this rank's bed and turn it at each of its missing speeds.
-static void run_missing_drum(drum_batch *b, int n_todo)
+// 1 if every missing run (all ranks') settles the same bed.
+static int one_fill(const drum_batch *b, const drum_run *missing, int n_missing)
 {
-    char err[1024];
-    b->bed = settled_bed(&b->c->fill, &b->bed_wall_s, err, sizeof err);
-    if (!b->bed) {
-        for (int i = 0; i < n_todo; ++i) write_failed(b->env, b->keys[b->todo[i]], err);
+    char first[1024], text[1024];
+    for (int i = 0; i < n_missing; ++i) {
+        drum_def_text(&b->cases[missing[i].c].fill, i ? text : first, sizeof text);
+        if (i && strcmp(text, first) != 0) return 0;
+    }
+    return 1;
+}
+
+// Deal the missing runs over the ranks and run this rank's share.
+static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missing)
+{
+    int rank = cal_mpi_rank(), size = cal_mpi_size();
+    if (one_fill(b, missing, n_missing)) { // runs dealt one by one
+        for (int i = 0; i < n_missing; ++i)
+            if (i % size == rank) b->todo[b->n_todo++] = missing[i];
+        if (b->n_todo == 0) return;
+        char err[1024];
+        b->bed = settled_bed(&b->cases[b->todo[0].c].fill, &b->bed_wall_s, err, sizeof err);
+        if (!b->bed) {
+            for (int i = 0; i < b->n_todo; ++i) write_failed(b->env, run_key(b, b->todo[i]), err);
+            return;
+        }
+        cal_pool_run(b->n_todo, turn_one, turned, b, b->env->workers, b->env->use_fork);
         return;
     }
-    cal_pool_run(n_todo, turn_one, turned, b, b->env->workers, b->env->use_fork);
+    int n_with = 0; // candidates dealt whole: each settles its own bed
+    for (int i = 0; i < n_missing; ++i) {
+        int first_of_case = i == 0 || missing[i].c != missing[i - 1].c;
+        if (first_of_case && n_with++ % size == rank) b->case_todo[b->n_case_todo++] = missing[i].c;
+    }
+    for (int i = 0; i < n_missing; ++i)
+        for (int j = 0; j < b->n_case_todo; ++j)
+            if (missing[i].c == b->case_todo[j]) b->todo[b->n_todo++] = missing[i];
+    if (b->n_case_todo > 0) cal_pool_run(b->n_case_todo, settle_and_turn, settled_and_turned, b, b->env->workers, b->env->use_fork);
+}
+
+int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
+                           cal_record *out, char *err, size_t len)
+{
+    if (n > 32) return exp_fail(err, len, "at most 32 speeds per candidate"), 1;
+    int runs = n_cases * n;
+    drum_batch b = {.env = env, .cases = cases, .n_cases = n_cases, .rpm = rpm, .n_rpm = n};
+    b.keys = calloc((size_t)runs, sizeof *b.keys);
+    b.todo = calloc((size_t)runs, sizeof *b.todo);
+    b.case_todo = calloc((size_t)n_cases, sizeof *b.case_todo);
+    drum_run *missing = calloc((size_t)runs, sizeof *missing);
+    int n_missing = 0, bad = !b.keys || !b.todo || !b.case_todo || !missing;
+    if (bad) exp_fail(err, len, "out of memory");
+    cal_mpi_barrier(); // every rank sees the same store, so all deal the missing runs alike
+    for (int c = 0; c < n_cases && !bad; ++c)
+        for (int k = 0; k < n && !bad; ++k) {
+            cal_drum_key(&cases[c], rpm[k], b.keys[c * n + k], sizeof b.keys[0]);
+            int got = cal_store_get(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
+            bad = got < 0;
+            if (got == 1) missing[n_missing++] = (drum_run){c, k};
+            if (got == 0) cal_record_free(&out[c * n + k]);
+        }
+    if (!bad && n_missing > 0) run_missing_drum(&b, missing, n_missing);
+    cal_mpi_barrier(); // every rank's records are on the shared store now
+    for (int i = 0; i < runs && !bad; ++i) bad = read_back(env, b.keys[i], &out[i], err, len);
+    free(b.keys), free(b.todo), free(b.case_todo), free(missing);
+    return bad;
 }
 
 int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
                       size_t len)
 {
-    if (n > 32) return exp_fail(err, len, "at most 32 speeds per candidate"), 1;
-    drum_batch *b = calloc(1, sizeof *b);
-    int todo[32], n_todo = 0, n_missing = 0;
-    if (!b) return exp_fail(err, len, "out of memory"), 1;
-    *b = (drum_batch){.env = env, .c = c, .rpm = rpm, .todo = todo};
-    cal_mpi_barrier(); // every rank sees the same store, so all deal the missing runs alike
-    for (int k = 0; k < n; ++k) {
-        cal_drum_key(c, rpm[k], b->keys[k], sizeof b->keys[k]);
-        int got = cal_store_get(env->store, b->keys[k], &out[k], err, len);
-        if (got < 0) return free(b), 1;
-        if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k;
-        if (got == 0) cal_record_free(&out[k]);
-    }
-    int bad = 0;
-    if (n_todo > 0) run_missing_drum(b, n_todo);
-    cal_mpi_barrier(); // every rank's records are on the shared store now
-    for (int k = 0; k < n && !bad; ++k)
-        bad = read_back(env, b->keys[k], &out[k], err, len);
-    free(b);
-    return bad;
+    return cal_drum_evaluate_many(env, c, 1, rpm, n, out, err, len);
 }
 
 // ---- poured cylinder --------------------------------------------------------
@@ -329,7 +424,7 @@ static void poured(int i, int code, void *ctx)
     char what[96];
     snprintf(what, sizeof what, "cylinder k_n = %g N/m, seed %llu", b->cases[k].granule.k_n,
              (unsigned long long)b->cases[k].seed);
-    finish_task(b->env, b->keys[k], what, code);
+    finish_run(b->env, b->keys[k], what, code);
 }
 
 int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len)

@@ -61,6 +61,11 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
 /// with a message (the store could not be read or written).
 int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
                       size_t len);
+/// The same for several candidates at once (out: n_cases × n records, by
+/// candidate): their missing runs share the workers, so one candidate's long
+/// speed does not leave the others idle.
+int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
+                           cal_record *out, char *err, size_t len);
 
 /// Records of poured cylinders, running the missing ones side by side.
 int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len);

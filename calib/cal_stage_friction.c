@@ -92,48 +92,85 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
     cal_candidate_score(r, k);
 }
 
-// "candidate i of at most N", with the time left at the pace so far.
-static void show_start(const search *s, double mu_s, double mu_r)
+// "candidate i of at most N" (or "candidates i-j"), with the time left at the pace so far.
+static void show_start(const search *s, const double (*mu)[2], int m)
 {
     int probes = cal_tier_bound_probes(s->t) ? 2 : 0;
     int planned = s->t->grid * s->t->grid + s->t->max_evaluations + probes, done = s->r->n;
     double spent = exp_wall_seconds() - s->started;
-    char eta[48] = "";
+    char eta[48] = "", which[32];
     if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
-    fprintf(stderr, "%s[%s] candidate %d of at most %d: mu_s = %.4g, mu_r = %.4g (%d speeds%s)%s", s->env->tty ? "\r\033[K" : "",
-            s->env->stage, done + 1, planned, mu_s, mu_r, s->n_sim, eta, s->env->tty ? "" : "\n");
+    if (m == 1) snprintf(which, sizeof which, "candidate %d", done + 1);
+    else snprintf(which, sizeof which, "candidates %d-%d", done + 1, done + m);
+    fprintf(stderr, "%s[%s] %s of at most %d: ", s->env->tty ? "\r\033[K" : "", s->env->stage, which, planned);
+    for (int j = 0; j < m; ++j) fprintf(stderr, "%smu_s = %.4g, mu_r = %.4g", j ? "; " : "", mu[j][0], mu[j][1]);
+    fprintf(stderr, " (%d speeds%s%s)%s", s->n_sim, m > 1 ? " each, side by side" : "", eta, s->env->tty ? "" : "\n");
 }
 
 static int same_value(double a, double b) { return fabs(a - b) <= 1e-12 * fmax(fabs(a), fabs(b)); }
 
-static cal_candidate *evaluate(search *s, double mu_s, double mu_r, const char *origin)
+// The candidate at (mu_s, mu_r) if evaluated before (COBYLA revisits, a probe at a grid point).
+static cal_candidate *seen(cal_friction_result *r, double mu_s, double mu_r)
+{
+    for (int i = 0; i < r->n; ++i)
+        if (same_value(r->cand[i].mu_s, mu_s) && same_value(r->cand[i].mu_r, mu_r)) return &r->cand[i];
+    return NULL;
+}
+
+// A new candidate from its records (released here).
+static void add_candidate(search *s, double mu_s, double mu_r, const char *origin, cal_record *rec, double elapsed,
+                          int together)
 {
     cal_friction_result *r = s->r;
-    for (int i = 0; i < r->n; ++i) // a point seen before (COBYLA revisits, a probe at a grid point): no new simulation
-        if (same_value(r->cand[i].mu_s, mu_s) && same_value(r->cand[i].mu_r, mu_r)) return &r->cand[i];
-    if (r->n >= CAL_MAX_EVALS || s->failed) return NULL;
-    cal_drum_case dc = s->material ? cal_drum_case_wall(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
-                                   : cal_drum_case_granule(s->c, s->t, r->k_n, mu_s, mu_r);
-    cal_record rec[CAL_MAX_RPM];
-    double t0 = exp_wall_seconds();
-    show_start(s, mu_s, mu_r);
-    if (cal_drum_evaluate(s->env, &dc, s->sim_rpm, s->n_sim, rec, s->err, s->len)) {
-        s->failed = 1;
-        return NULL;
-    }
     cal_candidate *k = &r->cand[r->n++];
     memset(k, 0, sizeof *k);
     k->mu_s = mu_s, k->mu_r = mu_r, k->origin = origin;
     score(s, k, rec);
     for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
         k->wall_time_s += rec[i].wall_time_s + rec[i].fill_wall_time_s, cal_record_free(&rec[i]);
-    double elapsed = exp_wall_seconds() - t0;
-    char with_angle[48] = "";
+    char with_angle[48] = "", took[48];
     if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", with the angle %.3g", k->objective);
-    fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g%s (%.0f s)\n",
+    if (together > 1) snprintf(took, sizeof took, "%.0f s for the %d together", elapsed, together);
+    else snprintf(took, sizeof took, "%.0f s", elapsed);
+    fprintf(stderr, "%s[%s] candidate %d: mu_s = %.4g, mu_r = %.4g: angle %.2f° (target %.2f ± %.2f), CSA misfit %.3g%s (%s)\n",
             s->env->tty ? "\r\033[K" : "", s->env->stage, r->n, mu_s, mu_r, k->angle_deg, r->angle_target,
-            r->angle_tolerance, k->misfit, with_angle, elapsed);
-    return k;
+            r->angle_tolerance, k->misfit, with_angle, took);
+}
+
+// Candidates at m (μs, μr) points, simulated together (the grid, the bound
+// probes: independent points whose runs can share the workers). A point
+// evaluated before, or twice in the list, is simulated once.
+static void evaluate_points(search *s, const double (*mu)[2], int m, const char *origin)
+{
+    cal_friction_result *r = s->r;
+    double(*fresh)[2] = calloc((size_t)m, sizeof *fresh);
+    cal_drum_case *cases = calloc((size_t)m, sizeof *cases);
+    cal_record *rec = calloc((size_t)m * (size_t)s->n_sim, sizeof *rec);
+    int n = 0;
+    if (!fresh || !cases || !rec) s->failed = 1, exp_fail(s->err, s->len, "out of memory");
+    for (int p = 0; p < m && !s->failed; ++p) {
+        int again = seen(r, mu[p][0], mu[p][1]) != NULL;
+        for (int q = 0; q < n; ++q) again |= same_value(fresh[q][0], mu[p][0]) && same_value(fresh[q][1], mu[p][1]);
+        if (again || r->n + n >= CAL_MAX_EVALS) continue;
+        fresh[n][0] = mu[p][0], fresh[n][1] = mu[p][1];
+        cases[n++] = s->material ? cal_drum_case_wall(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu[p][0], mu[p][1])
+                                 : cal_drum_case_granule(s->c, s->t, r->k_n, mu[p][0], mu[p][1]);
+    }
+    if (n > 0 && !s->failed) {
+        double t0 = exp_wall_seconds();
+        show_start(s, (const double(*)[2])fresh, n);
+        if (cal_drum_evaluate_many(s->env, cases, n, s->sim_rpm, s->n_sim, rec, s->err, s->len)) s->failed = 1;
+        double elapsed = exp_wall_seconds() - t0;
+        for (int j = 0; j < n && !s->failed; ++j) add_candidate(s, fresh[j][0], fresh[j][1], origin, rec + j * s->n_sim, elapsed, n);
+    }
+    free(fresh), free(cases), free(rec);
+}
+
+static cal_candidate *evaluate(search *s, double mu_s, double mu_r, const char *origin)
+{
+    const double point[1][2] = {{mu_s, mu_r}};
+    evaluate_points(s, point, 1, origin);
+    return seen(s->r, mu_s, mu_r);
 }
 
 // COBYLA's point of the unit square (μs linear, log10 μr).
@@ -260,6 +297,21 @@ static const char *run_cobyla(search *s)
     }
 }
 
+// The initial design: grid × grid points at the centres of the unit square's
+// cells, simulated together.
+static void evaluate_grid(search *s)
+{
+    int g = s->t->grid, m = 0;
+    if (g < 1) return;
+    double(*mu)[2] = calloc((size_t)(g * g), sizeof *mu);
+    if (!mu) return (void)(s->failed = 1, exp_fail(s->err, s->len, "out of memory"));
+    const cal_bounds *b = bounds_of(s);
+    for (int i = 0; i < g; ++i)
+        for (int j = 0; j < g; ++j) mu[m][0] = to_mu_s(b, (i + 0.5) / g), mu[m++][1] = to_mu_r(b, (j + 0.5) / g);
+    evaluate_points(s, (const double(*)[2])mu, m, "grid");
+    free(mu);
+}
+
 // After the search, the best μs with μr at each search bound: whether the
 // data bound μr on each side, or the identified range reaches the bound.
 static void probe_bounds(search *s)
@@ -268,8 +320,8 @@ static void probe_bounds(search *s)
     if (best < 0) return;
     const cal_bounds *b = bounds_of(s);
     double mu_s = s->r->cand[best].mu_s;
-    if (!s->failed) evaluate(s, mu_s, b->mu_r_min, "bound probe");
-    if (!s->failed) evaluate(s, mu_s, b->mu_r_max, "bound probe");
+    const double probes[2][2] = {{mu_s, b->mu_r_min}, {mu_s, b->mu_r_max}};
+    evaluate_points(s, probes, 2, "bound probe");
 }
 
 // Where a speed is in the tier's rpm list (0 when the tier takes every speed).
@@ -328,9 +380,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     env->stage = stage;
     search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
     if (set_targets(&s, angles, areas)) return 1;
-    for (int i = 0; i < t->grid && !s.failed; ++i)
-        for (int j = 0; j < t->grid && !s.failed; ++j)
-            evaluate_unit(&s, (const double[2]){(i + 0.5) / t->grid, (j + 0.5) / t->grid}, "grid");
+    evaluate_grid(&s);
     out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
     if (cal_tier_bound_probes(t)) probe_bounds(&s);
     out->best = cal_friction_best(out);

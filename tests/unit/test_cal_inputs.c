@@ -167,7 +167,7 @@ static void test_bad_config_named_by_line_and_field(void **state)
     expect_config_error("tier: quick", "tier: fast", "tier");               // unknown tier
     expect_config_error("damping: approaching", "damping: sometimes", "damping");
     expect_config_error("stiffness: [50, 100", "stiffness: [100, 50", "stiffness"); // not increasing
-    expect_config_error("max_evaluations: 1\n    angle_sd_deg: 2.0\n  # ci", "max_evaluations: -2\n    angle_sd_deg: 2.0\n  # ci",
+    expect_config_error("max_evaluations: 1\n    # Its drum", "max_evaluations: -2\n    # Its drum",
                         "max_evaluations");                                 // in a tier's own block
 }
 
