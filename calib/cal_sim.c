@@ -184,15 +184,16 @@ static int killed_from_outside(int sig)
     return sig == SIGKILL || sig == SIGTERM || sig == SIGINT || sig == SIGHUP || sig == SIGQUIT;
 }
 
-// Turn `bed` (this process's own, or a clone when inline) at run r's speed and
-// store the record; fill_s: the settling's wall time, charged to this run.
-static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill_s)
+// Turn `bed` at run r's speed and store the record; fill_s: the settling's
+// wall time, charged to this run. The bed itself is turned only when it is
+// this run's alone (a forked child's copy, own = 1); else a clone.
+static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill_s, int own)
 {
     const cal_drum_case *c = &b->cases[r.c];
     const char *key = run_key(b, r);
     exp_drum_run_opts run = c->run;
     run.rpm = b->rpm[r.k];
-    dem_world *w = b->env->use_fork ? bed : dem_world_clone(bed);
+    dem_world *w = own ? bed : dem_world_clone(bed);
     if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
     double t0 = exp_wall_seconds();
     exp_drum_result res;
@@ -210,7 +211,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     char err[512];
     int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
-    if (!b->env->use_fork) dem_world_destroy(w);
+    if (!own) dem_world_destroy(w);
     return bad;
 }
 
@@ -218,10 +219,11 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
 static int turn_one(int i, void *ctx)
 {
     drum_batch *b = ctx;
-    return turn_and_store(b, b->bed, b->todo[i], i == 0 ? b->bed_wall_s : 0);
+    return turn_and_store(b, b->bed, b->todo[i], i == 0 ? b->bed_wall_s : 0, b->env->use_fork);
 }
 
-// Own bed: task i settles candidate case_todo[i]'s bed and turns its missing speeds.
+// Own bed: task i settles candidate case_todo[i]'s bed and turns a copy of it
+// at each of its missing speeds.
 static int settle_and_turn(int i, void *ctx)
 {
     drum_batch *b = ctx;
@@ -233,7 +235,7 @@ static int settle_and_turn(int i, void *ctx)
     for (int j = 0; j < b->n_todo; ++j) {
         if (b->todo[j].c != c) continue;
         if (!bed) bad |= write_failed(b->env, run_key(b, b->todo[j]), err);
-        else bad |= turn_and_store(b, bed, b->todo[j], fill_s), fill_s = 0;
+        else bad |= turn_and_store(b, bed, b->todo[j], fill_s, 0), fill_s = 0;
     }
     dem_world_destroy(bed);
     return bad;
