@@ -378,7 +378,10 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
         }
     if (!bad && n_missing > 0) run_missing_drum(&b, missing, n_missing);
     cal_mpi_barrier(); // every rank's records are on the shared store now
-    for (int i = 0; i < runs && !bad; ++i) bad = read_back(env, b.keys[i], &out[i], err, len);
+    int read = 0;
+    while (!bad && read < runs) bad = read_back(env, b.keys[read], &out[read], err, len), read += !bad;
+    if (bad) // the caller gets no records: release those read
+        while (read > 0) cal_record_free(&out[--read]);
     free(b.keys), free(b.todo), free(b.case_todo), free(missing);
     return bad;
 }
