@@ -45,8 +45,9 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
     CYAML_FIELD_SEQUENCE("csa_sd_percent", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, csa_sd_percent,
                          &float_entry, 1, 32),
-    CYAML_FIELD_ENUM("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER | CYAML_FLAG_STRICT, cal_tier, bound_probes,
-                     yes_no, CYAML_ARRAY_LEN(yes_no)),
+    // _PTR: the plain ENUM macro drops CYAML_FLAG_POINTER and would write the value into the pointer itself.
+    CYAML_FIELD_ENUM_PTR("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, bound_probes, yes_no,
+                         CYAML_ARRAY_LEN(yes_no)),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 

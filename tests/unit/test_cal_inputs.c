@@ -120,6 +120,51 @@ static void test_shipped_config_loads(void **state)
     cal_config_free(c);
     assert_null(cal_config_load(path, "nonesuch", err, sizeof err));
     assert_non_null(strstr(err, "tier"));
+    // The optional tier keys as written: check's `bound_probes: false`, ci's
+    // three CSA spreads, quick's one for every speed, and probes on where unset.
+    c = cal_config_load(path, "check", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    assert_false(cal_tier_bound_probes(cal_config_tier(c)));
+    assert_true(cal_tier_csa_sd(cal_config_tier(c), 0) == 0);
+    cal_config_free(c);
+    c = cal_config_load(path, "ci", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    const cal_tier *ci = cal_config_tier(c);
+    assert_true(cal_tier_bound_probes(ci));
+    assert_true(cal_tier_csa_sd(ci, 0) == 0.55 && cal_tier_csa_sd(ci, 1) == 0.81 && cal_tier_csa_sd(ci, 2) == 1.37);
+    cal_config_free(c);
+    c = cal_config_load(path, "quick", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    assert_true(cal_tier_csa_sd(cal_config_tier(c), 0) == 3.1);
+    cal_config_free(c);
+}
+
+// bound_probes: true, and false, read as such (not as a pointer's value).
+static void test_bound_probes_read(void **state)
+{
+    (void)state;
+    char shipped[1200], path[] = "/tmp/granucal_probes_XXXXXX", err[1024];
+    snprintf(shipped, sizeof shipped, "%s/configs/calibration.yaml", source);
+    FILE *f = fopen(shipped, "r");
+    assert_non_null(f);
+    static char text[1 << 16], edited[1 << 16];
+    text[fread(text, 1, sizeof text - 1, f)] = '\0';
+    fclose(f);
+    const char *at = strstr(text, "bound_probes: false");
+    assert_non_null(at);
+    const char *words[] = {"true", "yes", "no"};
+    const int expected[] = {1, 1, 0};
+    for (int k = 0; k < 3; ++k) {
+        snprintf(edited, sizeof edited, "%.*sbound_probes: %s%s", (int)(at - text), text, words[k],
+                 at + strlen("bound_probes: false"));
+        close(mkstemp(path));
+        write_file(path, edited);
+        cal_config *c = cal_config_load(path, "check", err, sizeof err);
+        if (!c) fail_msg("%s", err);
+        assert_int_equal(cal_tier_bound_probes(cal_config_tier(c)), expected[k]);
+        cal_config_free(c);
+        unlink(path);
+    }
 }
 
 // Replace `from` by `to` in the shipped config and expect an error that names
@@ -448,6 +493,7 @@ int main(void)
         cmocka_unit_test(test_bad_csv_named_by_line_and_field),
         cmocka_unit_test(test_quoted_and_commented_csv_reads),
         cmocka_unit_test(test_shipped_config_loads),
+        cmocka_unit_test(test_bound_probes_read),
         cmocka_unit_test(test_bad_config_named_by_line_and_field),
         cmocka_unit_test(test_fuzz_findings_refused),
         cmocka_unit_test(test_store_round_trip_and_collision_check),
