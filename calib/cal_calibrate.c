@@ -81,15 +81,16 @@ static int parse_options(int argc, char **argv, options *o)
     int c;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
-        char *end;
+        double v;
         switch (c) {
         case 't': o->tier = optarg; break;
         case 's': o->stage = optarg; break;
         case 'm': o->material = optarg, o->stage = "wall"; break;
         case 'o': o->out = optarg; break;
         case 'j':
-            o->jobs = (int)strtol(optarg, &end, 10);
-            if (*end || o->jobs < 1 || o->jobs > 1024) return fprintf(stderr, "granucal calibrate: --jobs '%s': expected 1..1024\n", optarg), 2;
+            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024))
+                return fprintf(stderr, "granucal calibrate: --jobs '%s': expected a whole number in 1..1024\n", optarg), 2;
+            o->jobs = (int)v;
             break;
         case 'h': fputs(help, stdout); return -1;
         default: fputs("\n", stderr), fputs(help, stderr); return 2;

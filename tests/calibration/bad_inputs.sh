@@ -40,6 +40,7 @@ expect "text in a number" ": xi: Invalid FLOAT value" -- "$(edit xi 's/^xi: 0.7/
 expect "unknown key" "viscosity: Unexpected key" -- "$(edit key 's/^seed: 1/seed: 1\nviscosity: 2/')" "${out[@]}"
 expect "unknown angle rule" "angle_rule: 'maybe'" -- "$(edit rule 's/angle_rule: misfit/angle_rule: maybe/')" "${out[@]}"
 expect "negative CSA spread" "csa_sd_percent: -0.55 must be in [0, 50)" -- "$(edit csa_sd 's/csa_sd_percent: \[0.55,/csa_sd_percent: [-0.55,/')" "${out[@]}"
+expect "fractional --jobs" "--jobs '2.5': expected a whole number in 1..1024" -- "$work/configs/good.yaml" --jobs 2.5 "${out[@]}"
 expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perhaps" -- "$(edit probes 's/bound_probes: false/bound_probes: perhaps/')" "${out[@]}"
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
