@@ -104,6 +104,17 @@ static void test_quoted_and_commented_csv_reads(void **state)
     unlink(path);
 }
 
+// A shipped config file (configs/NAME) into text[cap].
+static void read_shipped(const char *name, char *text, size_t cap)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/configs/%s", source, name);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    text[fread(text, 1, cap - 1, f)] = '\0';
+    fclose(f);
+}
+
 static void test_shipped_config_loads(void **state)
 {
     (void)state;
@@ -143,13 +154,9 @@ static void test_shipped_config_loads(void **state)
 static void test_bound_probes_read(void **state)
 {
     (void)state;
-    char shipped[1200], path[] = "/tmp/granucal_probes_XXXXXX", err[1024];
-    snprintf(shipped, sizeof shipped, "%s/configs/calibration.yaml", source);
-    FILE *f = fopen(shipped, "r");
-    assert_non_null(f);
+    char path[] = "/tmp/granucal_probes_XXXXXX", err[1024];
     static char text[1 << 16], edited[1 << 16];
-    text[fread(text, 1, sizeof text - 1, f)] = '\0';
-    fclose(f);
+    read_shipped("calibration.yaml", text, sizeof text);
     const char *at = strstr(text, "bound_probes: false");
     assert_non_null(at);
     const char *words[] = {"true", "yes", "no"};
@@ -171,14 +178,9 @@ static void test_bound_probes_read(void **state)
 // the field and the line where `to` stands.
 static void expect_config_error(const char *from, const char *to, const char *field)
 {
-    char shipped[1200], path[] = "/tmp/granucal_cfg_XXXXXX", err[1024], want[1300];
-    snprintf(shipped, sizeof shipped, "%s/configs/calibration.yaml", source);
-    FILE *f = fopen(shipped, "r");
-    assert_non_null(f);
+    char path[] = "/tmp/granucal_cfg_XXXXXX", err[1024], want[1300];
     static char text[1 << 16];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    text[n] = '\0';
-    fclose(f);
+    read_shipped("calibration.yaml", text, sizeof text);
     char *at = strstr(text, from);
     assert_non_null(at);
     static char edited[1 << 16];
@@ -261,13 +263,8 @@ static void test_fuzz_findings_refused(void **state)
     expect_config_error("stiffness_tolerance: 0 ", "stiffness_tolerance: inf ", "stiffness_tolerance");
     expect_config_error("max_evaluations: 2\n", "max_evaluations: 2\n    sample_interval: inf\n", "sample_interval");
     // Drum config: inf passed "max_time > 0" (and window, sample_interval, pixel, slice_depth).
-    char shipped[1200];
-    snprintf(shipped, sizeof shipped, "%s/configs/drum.yaml", source);
-    FILE *f = fopen(shipped, "r");
-    assert_non_null(f);
     static char text[1 << 14], edited[1 << 14];
-    text[fread(text, 1, sizeof text - 1, f)] = '\0';
-    fclose(f);
+    read_shipped("drum.yaml", text, sizeof text);
     const char *at = strstr(text, "max_time: 6.0");
     assert_non_null(at);
     snprintf(edited, sizeof edited, "%.*smax_time: inf%s", (int)(at - text), text, at + strlen("max_time: 6.0"));
