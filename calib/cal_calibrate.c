@@ -238,6 +238,14 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
     return 0;
 }
 
+// Where a friction stage's pair came from: sources[0] if it matches the angle,
+// [1] if it is the best misfit of a tier that puts the angle in the misfit,
+// [2] if it is only the closest to the angle.
+static const char *friction_source(const cal_friction_result *f, const char *const sources[3])
+{
+    return f->best_feasible ? sources[0] : f->angle_in_misfit ? sources[1] : sources[2];
+}
+
 static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const char **source)
 {
     *mu_s = r->c->granule_mu_s, *mu_r = r->c->granule_mu_r, *source = "config granule_mu_s/mu_r (stage 2 not run)";
@@ -251,9 +259,10 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
         const cal_candidate *b = &r->granule->cand[r->granule->best];
         *mu_s = b->mu_s, *mu_r = b->mu_r;
         r->table.gg_mu_s_range = r->granule->mu_s_range, r->table.gg_mu_r_range = r->granule->mu_r_range;
-        *source = r->granule->best_feasible    ? "stage 2 (drum lined with granules)"
-                  : r->granule->angle_in_misfit ? "stage 2, best misfit (angle outside its tolerance)"
-                                                : "stage 2, closest (angle not matched)";
+        static const char *const sources[3] = {"stage 2 (drum lined with granules)",
+                                               "stage 2, best misfit (angle outside its tolerance)",
+                                               "stage 2, closest (angle not matched)"};
+        *source = friction_source(r->granule, sources);
         const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
         return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
     }
@@ -284,10 +293,10 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
         snprintf(r->table.wall_name[t], 32, "%s", m->name);
         r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
         r->table.wall_mu_s_range[t] = w->mu_s_range, r->table.wall_mu_r_range[t] = w->mu_r_range;
-        snprintf(r->table.wall_source[t], 96, "%s",
-                 w->best_feasible    ? "stage 3 (drum lined with it)"
-                 : w->angle_in_misfit ? "stage 3, best misfit (angle outside its tolerance)"
-                                      : "stage 3, closest (angle not matched)");
+        static const char *const sources[3] = {"stage 3 (drum lined with it)",
+                                               "stage 3, best misfit (angle outside its tolerance)",
+                                               "stage 3, closest (angle not matched)"};
+        snprintf(r->table.wall_source[t], 96, "%s", friction_source(w, sources));
     }
     return 0;
 }

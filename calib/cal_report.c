@@ -378,12 +378,10 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
                       "measured (csa_sd_percent), so the ranges are too narrow",
             r->chi2_threshold, r->identified_count, r->n);
     fputs("| candidate | from | μs | μr | angle (°) | χ² | Δχ² | told apart |\n|---|---|---|---|---|---|---|---|\n", f);
-    double least = INFINITY;
-    for (int i = 0; i < r->n; ++i) least = fmin(least, r->cand[i].chi2);
     for (int i = 0; i < r->n; ++i) {
         const cal_candidate *k = &r->cand[i];
         fprintf(f, "| %d | %s | %.4g | %.4g | %.2f | %.3g | %.3g | %s |\n", i + 1, k->origin ? k->origin : "", k->mu_s,
-                k->mu_r, k->angle_deg, k->chi2, k->chi2 - least, k->identified ? "no" : "yes");
+                k->mu_r, k->angle_deg, k->chi2, k->chi2 - r->chi2_least, k->identified ? "no" : "yes");
     }
     fputc('\n', f);
     if (!isfinite(r->mu_s_range.lo)) return;

@@ -59,20 +59,33 @@ static double to_mu_r(const cal_bounds *b, double v)
 }
 static const cal_bounds *bounds_of(const search *s) { return s->material ? &s->c->wall : &s->c->granule; }
 
+// A measurement's squared z-score, or the penalty where it failed.
+static double squared_z(double value, double target, double sd, int usable)
+{
+    double z = (value - target) / sd;
+    return usable && isfinite(z) ? z * z : failed_speed_penalty;
+}
+
+// The angle's squared z-score against its tolerance.
+static double angle_z2(const cal_friction_result *r, const cal_candidate *k)
+{
+    return squared_z(k->angle_deg, r->angle_target, fmax(r->angle_tolerance, min_angle_sd), 1);
+}
+
+// Speed i's CSA squared z-score; tier_sd: the tier's spread added in quadrature (0: the lab's alone).
+static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
+{
+    double lab = fmax(r->csa_data_sd[i], min_csa_sd);
+    return squared_z(k->csa[i], r->csa_data[i], sqrt(lab * lab + tier_sd * tier_sd), k->usable[i]);
+}
+
 void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
 {
     k->angle_violation = isfinite(k->angle_deg) ? fabs(k->angle_deg - r->angle_target) - r->angle_tolerance : 90;
     double sum = 0;
-    for (int i = 0; i < r->n_rpm; ++i) {
-        double z = (k->csa[i] - r->csa_data[i]) / fmax(r->csa_data_sd[i], min_csa_sd);
-        sum += k->usable[i] ? z * z : failed_speed_penalty;
-    }
+    for (int i = 0; i < r->n_rpm; ++i) sum += csa_z2(r, k, i, 0);
     k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
-    k->objective = k->misfit;
-    if (r->angle_in_misfit) {
-        double z = (k->angle_deg - r->angle_target) / fmax(r->angle_tolerance, min_angle_sd);
-        k->objective = ((isfinite(z) ? z * z : failed_speed_penalty) + sum) / (r->n_rpm + 1);
-    }
+    k->objective = r->angle_in_misfit ? (angle_z2(r, k) + sum) / (r->n_rpm + 1) : k->misfit;
 }
 
 // The candidate's measurements from its records, then its scores.
@@ -222,13 +235,8 @@ int cal_friction_best(const cal_friction_result *r)
 // spreads in quadrature.
 static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 {
-    double z = (k->angle_deg - r->angle_target) / fmax(r->angle_tolerance, min_angle_sd);
-    double sum = isfinite(z) ? z * z : failed_speed_penalty;
-    for (int i = 0; i < r->n_rpm; ++i) {
-        double lab = fmax(r->csa_data_sd[i], min_csa_sd), tier = r->csa_tier_sd[i];
-        double zc = (k->csa[i] - r->csa_data[i]) / sqrt(lab * lab + tier * tier);
-        sum += k->usable[i] ? zc * zc : failed_speed_penalty;
-    }
+    double sum = angle_z2(r, k);
+    for (int i = 0; i < r->n_rpm; ++i) sum += csa_z2(r, k, i, r->csa_tier_sd[i]);
     return sum;
 }
 
@@ -255,11 +263,12 @@ static cal_range range_of(const cal_friction_result *r, int rolling)
 void cal_friction_identify(cal_friction_result *r)
 {
     r->chi2_threshold = gsl_cdf_chisq_Qinv(0.05, 1); // 3.84
-    double least = INFINITY;
-    for (int i = 0; i < r->n; ++i) r->cand[i].chi2 = chi2_of(r, &r->cand[i]), least = fmin(least, r->cand[i].chi2);
+    r->chi2_least = INFINITY;
+    for (int i = 0; i < r->n; ++i)
+        r->cand[i].chi2 = chi2_of(r, &r->cand[i]), r->chi2_least = fmin(r->chi2_least, r->cand[i].chi2);
     r->identified_count = 0;
     for (int i = 0; i < r->n; ++i) {
-        r->cand[i].identified = r->cand[i].chi2 - least <= r->chi2_threshold;
+        r->cand[i].identified = r->cand[i].chi2 - r->chi2_least <= r->chi2_threshold;
         r->identified_count += r->cand[i].identified;
     }
     r->mu_s_range = range_of(r, 0), r->mu_r_range = range_of(r, 1);

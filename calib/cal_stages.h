@@ -74,6 +74,7 @@ typedef struct cal_friction_result {
     cal_candidate cand[CAL_MAX_EVALS];
     int best;                           ///< index of the chosen candidate, -1 if none usable
     int best_feasible;                  ///< 1 if it matches the angle
+    double chi2_least;                  ///< the smallest χ² of the candidates
     double chi2_threshold;              ///< Δχ² within which candidates are not told apart
     cal_range mu_s_range, mu_r_range;   ///< what the data identify (cal_friction_identify)
     int identified_count;               ///< candidates within the threshold
