@@ -106,36 +106,72 @@ void dem_imp_scratch_free(dem_imp_scratch *s)
 // block (pair_loop_threaded adds them in the serial order).
 enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
 
+// What the pair loop reads on every pair, copied out of the world once per
+// force evaluation. The loop stores doubles (forces, springs) through
+// pointers the compiler cannot tell apart from the world's own fields, so
+// read from the world it would reload the coefficients and flags after every
+// store; a local copy stays in registers.
+typedef struct pair_ctx {
+    const dem_vec3 *pos, *vel, *omg;
+    const double *rad, *inv_mass;
+    dem_vec3 *frc, *trq;
+    const uint32_t *nbr;
+    double *hist;
+    dem_contact_coeffs gg;
+    double half_lever; // ½ lever_factor: lever arm R − ½h (or R)
+    double hist_dt;
+    double period;     // length along the periodic axis
+    int axis;          // periodic axis, or −1
+    int implicit_damping, implicit_springs;
+} pair_ctx;
+
+static inline pair_ctx pair_ctx_make(const dem_world *w)
+{
+    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist, w->gg,
+                      0.5 * w->lever_factor, w->hist_dt, dem_world_period(w), w->def.periodic_axis,
+                      w->def.implicit_damping, w->imp.on};
+}
+
+// Minimum image of one component along a period of length len.
+static DEM_ALWAYS_INLINE double wrap_component(double c, double len)
+{
+    return c > 0.5 * len ? c - len : c < -0.5 * len ? c + len : c;
+}
+
 // Minimum image along the periodic axis. Centres are wrapped into the domain
 // by every drift, so a separation is shorter than one period and one compare
 // does it; a granule placed outside the domain, before its first drift,
-// takes the general dem_world_min_image.
+// takes the general dem_world_min_image. A switch on named components, not a
+// pointer to one, keeps the separation in registers.
 static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(const dem_world *w, dem_vec3 d, int axis, double len)
 {
     dem_vec3 s = d;
-    double *c = axis == 0 ? &s.x : axis == 1 ? &s.y : &s.z;
-    if (*c > 0.5 * len) *c -= len;
-    else if (*c < -0.5 * len) *c += len;
-    return fabs(*c) <= 0.5 * len ? s : dem_world_min_image(w, d);
+    double c;
+    switch (axis) {
+    case 0: c = s.x = wrap_component(d.x, len); break;
+    case 1: c = s.y = wrap_component(d.y, len); break;
+    default: c = s.z = wrap_component(d.z, len); break;
+    }
+    return fabs(c) <= 0.5 * len ? s : dem_world_min_image(w, d);
 }
 
-static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t k, const unsigned mask,
-                                         const int direct, int axis, double len)
+static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *restrict c, size_t i, size_t k,
+                                         const unsigned mask, const int direct)
 {
-    const uint32_t j = w->nl.j[k];
+    const uint32_t j = c->nbr[k];
     const int hl = dem_history_len(mask);
-    double *restrict hist = w->nl.hist + k * (size_t)hl;
-    const dem_vec3 *restrict pos = w->pos;
+    double *restrict hist = c->hist + k * (size_t)hl;
+    const dem_vec3 *restrict pos = c->pos;
     dem_vec3 d = dem_v3_sub(pos[j], pos[i]);
-    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(w, d, axis, len);
-    const double ri = w->rad[i], rj = w->rad[j], rsum = ri + rj;
+    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(w, d, c->axis, c->period);
+    const double ri = c->rad[i], rj = c->rad[j], rsum = ri + rj;
     const double dist2 = dem_v3_norm2(d);
     if (dist2 >= rsum * rsum) {
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         if (!direct) w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
-        if (w->def.implicit_damping) w->pair_g[k] = 0.0;
-        if (w->imp.on) w->imp.pair[k] = (dem_imp_contact){{0, 0, 0}, 0, 0, 0, 0, 0, 0};
+        if (c->implicit_damping) w->pair_g[k] = 0.0;
+        if (c->implicit_springs) w->imp.pair[k] = (dem_imp_contact){{0, 0, 0}, 0, 0, 0, 0, 0, 0};
         return;
     }
     const double dist = sqrt(dist2);
@@ -143,24 +179,24 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t
     s.normal = safe_normal(d, dist);
     s.overlap = rsum - dist;
     // Lever arms: centre to contact point (or R, see dem_lever_arm).
-    const double ai = ri - 0.5 * w->lever_factor * s.overlap;
-    const double aj = rj - 0.5 * w->lever_factor * s.overlap;
-    const dem_vec3 n = s.normal, wi = w->omg[i], wj = w->omg[j];
+    const double ai = ri - c->half_lever * s.overlap;
+    const double aj = rj - c->half_lever * s.overlap;
+    const dem_vec3 n = s.normal, wi = c->omg[i], wj = c->omg[j];
     // Eq. 5 and 7: velocity of i's contact point relative to j's.
-    s.vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)),
-                        dem_v3_sub(w->vel[j], dem_v3_cross(dem_v3_scale(wj, aj), n)));
+    s.vrel = dem_v3_sub(dem_v3_add(c->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)),
+                        dem_v3_sub(c->vel[j], dem_v3_cross(dem_v3_scale(wj, aj), n)));
     s.wrel = dem_v3_sub(wi, wj);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * w->hist_dt;
-    s.reduced_mass = 1.0 / (w->inv_mass[i] + w->inv_mass[j]);
+    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
+    s.reduced_mass = 1.0 / (c->inv_mass[i] + c->inv_mass[j]);
     s.reduced_radius = ri * rj / rsum;
-    s.dt = w->hist_dt;
+    s.dt = c->hist_dt;
     dem_contact_out out;
-    dem_contact_eval(&w->gg, &s, hist, &out, mask);
-    if (w->def.implicit_damping) { // read only by gather_damping
+    dem_contact_eval(&c->gg, &s, hist, &out, mask);
+    if (c->implicit_damping) { // read only by gather_damping
         w->pair_g[k] = out.damping_coeff;
         w->pair_n[k] = n;
     }
-    if (w->imp.on)
+    if (c->implicit_springs)
         w->imp.pair[k] =
             (dem_imp_contact){n, out.damping_coeff, out.k_tangential, out.k_rolling, ai, aj, s.reduced_radius};
     // Eq. 9–10: torques on i and on j.
@@ -168,10 +204,11 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, size_t i, size_t
     const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
     const dem_vec3 ti = dem_v3_sub(dem_v3_scale(ts, ai), tr), tj = dem_v3_add(dem_v3_scale(ts, aj), tr);
     if (direct) {
-        w->frc[i] = dem_v3_add(w->frc[i], out.force);
-        w->frc[j] = dem_v3_sub(w->frc[j], out.force); // Newton's third law
-        w->trq[i] = dem_v3_add(w->trq[i], ti);
-        w->trq[j] = dem_v3_add(w->trq[j], tj);
+        dem_vec3 *restrict frc = c->frc, *restrict trq = c->trq;
+        frc[i] = dem_v3_add(frc[i], out.force);
+        frc[j] = dem_v3_sub(frc[j], out.force); // Newton's third law
+        trq[i] = dem_v3_add(trq[i], ti);
+        trq[j] = dem_v3_add(trq[j], tj);
     } else {
         w->pair_f[k] = out.force;
         w->pair_ti[k] = ti;
@@ -189,13 +226,15 @@ static inline void thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
 
 // The serial order, the reference every thread count reproduces bit for bit:
 // rows ascending, each pair added to i and to j as it comes.
-static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsigned mask, int axis, double len)
+static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsigned mask)
 {
     const size_t n = w->n;
+    const pair_ctx c = pair_ctx_make(w);
+    const size_t *restrict start = w->nl.start;
     memset(w->frc, 0, n * sizeof *w->frc);
     memset(w->trq, 0, n * sizeof *w->trq);
     for (size_t i = 0; i < n; ++i)
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
+        for (size_t k = start[i]; k < start[i + 1]; ++k) pair_force(w, &c, i, k, mask, DEM_DIRECT);
 }
 
 // Threads: each owns a block of granules and adds the pairs inside it
@@ -206,8 +245,9 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
 // then walks its rows as the serial loop does, taking the outgoing crossing
 // pairs' part from their slots at the end of each row. Every granule sums the
 // same terms in the same order as pair_loop_serial.
-static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask, int axis, double len)
+static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask)
 {
+    const pair_ctx c = pair_ctx_make(w);
     const size_t *start = w->nl.start;
     const uint32_t *nbr = w->nl.j;
 #pragma omp parallel
@@ -216,7 +256,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
         thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
         for (size_t i = lo; i < hi; ++i) // outgoing crossing pairs: into slots
             for (size_t k = start[i + 1]; k > start[i] && nbr[k - 1] >= hi; --k)
-                pair_force(w, i, k - 1, mask, DEM_SLOTS, axis, len);
+                pair_force(w, &c, i, k - 1, mask, DEM_SLOTS);
 #pragma omp barrier
         const size_t first_own_pair = start[lo];
         for (size_t i = lo; i < hi; ++i) { // incoming crossing pairs: partner rows below lo
@@ -232,7 +272,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
         for (size_t i = lo; i < hi; ++i)
             for (size_t k = start[i]; k < start[i + 1]; ++k) {
                 if (nbr[k] < hi) {
-                    pair_force(w, i, k, mask, DEM_DIRECT, axis, len);
+                    pair_force(w, &c, i, k, mask, DEM_DIRECT);
                 } else {
                     w->frc[i] = dem_v3_add(w->frc[i], w->pair_f[k]);
                     w->trq[i] = dem_v3_add(w->trq[i], w->pair_ti[k]);
@@ -243,10 +283,8 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
 
 static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
 {
-    const int axis = w->def.periodic_axis;
-    const double len = dem_world_period(w);
-    if (dem_forces_threaded(w)) pair_loop_threaded(w, mask, axis, len);
-    else pair_loop_serial(w, mask, axis, len);
+    if (dem_forces_threaded(w)) pair_loop_threaded(w, mask);
+    else pair_loop_serial(w, mask);
 }
 
 // Accumulate γ n nᵀ into a symmetric 3×3 stored as xx yy zz xy xz yz.
