@@ -11,6 +11,8 @@
 #ifndef DEM_CONTACT_H
 #define DEM_CONTACT_H
 
+#include <float.h>
+
 #include "dem_vec.h"
 
 /// Effects a scene can switch on. Unused effects cost nothing: the force
@@ -131,13 +133,15 @@ int dem_contact_params_check(const dem_contact_params *p, char *msg, unsigned lo
 /// neither creates nor destroys spring length.
 static DEM_ALWAYS_INLINE dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twist)
 {
+    // Branch-free, so that a batch of contacts vectorises (dem_forces.c): a
+    // zero spring, or one turned onto n, projects to zero and keeps scale 0;
+    // the guard only keeps the unused quotient finite.
     double len2 = dem_v3_norm2(spring);
-    if (len2 == 0.0) return spring;
     dem_vec3 turned = dem_v3_axpy(twist, dem_v3_cross(n, spring), spring);
     dem_vec3 proj = dem_v3_axpy(-dem_v3_dot(turned, n), n, turned);
     double plen2 = dem_v3_norm2(proj);
-    double scale = plen2 > 0.0 ? sqrt(len2 / plen2) : 0.0;
-    return dem_v3_scale(proj, scale);
+    double ratio = sqrt(len2 / (plen2 > DBL_MIN ? plen2 : DBL_MIN));
+    return dem_v3_scale(proj, plen2 > 0.0 ? ratio : 0.0);
 }
 
 /// Advance one history spring by its relative velocity and apply the Coulomb
@@ -150,12 +154,14 @@ static DEM_ALWAYS_INLINE dem_vec3 dem_spring_update(double *hist, dem_vec3 n, do
     dem_vec3 spring = dem_spring_carry(dem_v3(hist[0], hist[1], hist[2]), n, twist);
     spring = dem_v3_axpy(dt, vel, spring);
     dem_vec3 force = dem_v3_scale(spring, -k);
+    // Branch-free as dem_spring_carry: both outcomes computed, one kept.
     double f2 = dem_v3_norm2(force);
-    *sticking = !(f2 > limit * limit);
-    if (f2 > limit * limit) {
-        force = dem_v3_scale(force, limit / sqrt(f2));
-        spring = dem_v3_scale(force, -inv_k);
-    }
+    const int slides = f2 > limit * limit;
+    *sticking = !slides;
+    const dem_vec3 truncated = dem_v3_scale(force, limit / sqrt(f2 > DBL_MIN ? f2 : DBL_MIN));
+    const dem_vec3 reset = dem_v3_scale(truncated, -inv_k);
+    force = slides ? truncated : force;
+    spring = slides ? reset : spring;
     hist[0] = spring.x;
     hist[1] = spring.y;
     hist[2] = spring.z;

@@ -155,18 +155,87 @@ static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(const dem_world *w, dem_vec3 d
     return fabs(c) <= 0.5 * len ? s : dem_world_min_image(w, d);
 }
 
+// One granule's side of a pair: what the contact law reads of it.
+typedef struct pair_side {
+    dem_vec3 vel, omg;
+    double rad, inv_mass;
+} pair_side;
+
+// What a touching pair does: force on i (j gets −force), torques on i and j,
+// and what the implicit integrations read.
+typedef struct pair_result {
+    dem_vec3 force, torque_i, torque_j, normal;
+    double damping_coeff, k_tangential, k_rolling, lever_i, lever_j, reduced_radius;
+} pair_result;
+
+// The contact of a touching pair with separation d = r_j − r_i (minimum
+// image): geometry, eq. 5 and 7 kinematics, the law (dem_contact_eval) and
+// the torques of eq. 9–10. Shared by the scalar path and the batch loop, so
+// both are the same arithmetic, bit for bit.
+static DEM_ALWAYS_INLINE pair_result pair_contact(const pair_ctx *restrict c, dem_vec3 d, const pair_side *si,
+                                                  const pair_side *sj, double *restrict hist, const unsigned mask)
+{
+    const double ri = si->rad, rj = sj->rad, rsum = ri + rj;
+    const double dist = sqrt(dem_v3_norm2(d));
+    dem_contact_state s;
+    s.normal = safe_normal(d, dist);
+    s.overlap = rsum - dist;
+    // Lever arms: centre to contact point (or R, see dem_lever_arm).
+    const double ai = ri - c->half_lever * s.overlap;
+    const double aj = rj - c->half_lever * s.overlap;
+    const dem_vec3 n = s.normal, wi = si->omg, wj = sj->omg;
+    // Eq. 5 and 7: velocity of i's contact point relative to j's.
+    s.vrel = dem_v3_sub(dem_v3_add(si->vel, dem_v3_cross(dem_v3_scale(wi, ai), n)),
+                        dem_v3_sub(sj->vel, dem_v3_cross(dem_v3_scale(wj, aj), n)));
+    s.wrel = dem_v3_sub(wi, wj);
+    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
+    s.reduced_mass = 1.0 / (si->inv_mass + sj->inv_mass);
+    s.reduced_radius = ri * rj / rsum;
+    s.dt = c->hist_dt;
+    dem_contact_out out;
+    dem_contact_eval(&c->gg, &s, hist, &out, mask);
+    // Eq. 9–10: torques on i and on j.
+    const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
+    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
+    return (pair_result){out.force, dem_v3_sub(dem_v3_scale(ts, ai), tr), dem_v3_add(dem_v3_scale(ts, aj), tr), n,
+                         out.damping_coeff, out.k_tangential, out.k_rolling, ai, aj, s.reduced_radius};
+}
+
+static DEM_ALWAYS_INLINE pair_side side_of(const pair_ctx *restrict c, size_t i)
+{
+    return (pair_side){c->vel[i], c->omg[i], c->rad[i], c->inv_mass[i]};
+}
+
+// Separation r_j − r_i of a listed pair, and whether the granules touch.
+static DEM_ALWAYS_INLINE int pair_touches(dem_world *restrict w, const pair_ctx *restrict c, size_t i, uint32_t j,
+                                          const unsigned mask, dem_vec3 *d)
+{
+    *d = dem_v3_sub(c->pos[j], c->pos[i]);
+    if (mask & DEM_FEAT_PERIODIC) *d = wrap_separation(w, *d, c->axis, c->period);
+    const double rsum = c->rad[i] + c->rad[j];
+    return dem_v3_norm2(*d) < rsum * rsum;
+}
+
+static DEM_ALWAYS_INLINE void add_to_pair(const pair_ctx *restrict c, size_t i, size_t j, dem_vec3 f, dem_vec3 ti,
+                                          dem_vec3 tj)
+{
+    dem_vec3 *restrict frc = c->frc, *restrict trq = c->trq;
+    frc[i] = dem_v3_add(frc[i], f);
+    frc[j] = dem_v3_sub(frc[j], f); // Newton's third law
+    trq[i] = dem_v3_add(trq[i], ti);
+    trq[j] = dem_v3_add(trq[j], tj);
+}
+
+// One pair, scalar: the implicit integrations (which keep per-pair data) and
+// the pairs crossing a thread's block (SLOTS) come this way.
 static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *restrict c, size_t i, size_t k,
                                          const unsigned mask, const int direct)
 {
     const uint32_t j = c->nbr[k];
     const int hl = dem_history_len(mask);
     double *restrict hist = c->hist + k * (size_t)hl;
-    const dem_vec3 *restrict pos = c->pos;
-    dem_vec3 d = dem_v3_sub(pos[j], pos[i]);
-    if (mask & DEM_FEAT_PERIODIC) d = wrap_separation(w, d, c->axis, c->period);
-    const double ri = c->rad[i], rj = c->rad[j], rsum = ri + rj;
-    const double dist2 = dem_v3_norm2(d);
-    if (dist2 >= rsum * rsum) {
+    dem_vec3 d;
+    if (!pair_touches(w, c, i, j, mask, &d)) {
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         if (!direct) w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
@@ -174,46 +243,152 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *
         if (c->implicit_springs) w->imp.pair[k] = (dem_imp_contact){{0, 0, 0}, 0, 0, 0, 0, 0, 0};
         return;
     }
-    const double dist = sqrt(dist2);
-    dem_contact_state s;
-    s.normal = safe_normal(d, dist);
-    s.overlap = rsum - dist;
-    // Lever arms: centre to contact point (or R, see dem_lever_arm).
-    const double ai = ri - c->half_lever * s.overlap;
-    const double aj = rj - c->half_lever * s.overlap;
-    const dem_vec3 n = s.normal, wi = c->omg[i], wj = c->omg[j];
-    // Eq. 5 and 7: velocity of i's contact point relative to j's.
-    s.vrel = dem_v3_sub(dem_v3_add(c->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)),
-                        dem_v3_sub(c->vel[j], dem_v3_cross(dem_v3_scale(wj, aj), n)));
-    s.wrel = dem_v3_sub(wi, wj);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
-    s.reduced_mass = 1.0 / (c->inv_mass[i] + c->inv_mass[j]);
-    s.reduced_radius = ri * rj / rsum;
-    s.dt = c->hist_dt;
-    dem_contact_out out;
-    dem_contact_eval(&c->gg, &s, hist, &out, mask);
+    const pair_side si = side_of(c, i), sj = side_of(c, j);
+    const pair_result r = pair_contact(c, d, &si, &sj, hist, mask);
     if (c->implicit_damping) { // read only by gather_damping
-        w->pair_g[k] = out.damping_coeff;
-        w->pair_n[k] = n;
+        w->pair_g[k] = r.damping_coeff;
+        w->pair_n[k] = r.normal;
     }
     if (c->implicit_springs)
-        w->imp.pair[k] =
-            (dem_imp_contact){n, out.damping_coeff, out.k_tangential, out.k_rolling, ai, aj, s.reduced_radius};
-    // Eq. 9–10: torques on i and on j.
-    const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
-    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
-    const dem_vec3 ti = dem_v3_sub(dem_v3_scale(ts, ai), tr), tj = dem_v3_add(dem_v3_scale(ts, aj), tr);
+        w->imp.pair[k] = (dem_imp_contact){r.normal, r.damping_coeff, r.k_tangential, r.k_rolling,
+                                           r.lever_i,  r.lever_j,     r.reduced_radius};
     if (direct) {
-        dem_vec3 *restrict frc = c->frc, *restrict trq = c->trq;
-        frc[i] = dem_v3_add(frc[i], out.force);
-        frc[j] = dem_v3_sub(frc[j], out.force); // Newton's third law
-        trq[i] = dem_v3_add(trq[i], ti);
-        trq[j] = dem_v3_add(trq[j], tj);
+        add_to_pair(c, i, j, r.force, r.torque_i, r.torque_j);
     } else {
-        w->pair_f[k] = out.force;
-        w->pair_ti[k] = ti;
-        w->pair_tj[k] = tj;
+        w->pair_f[k] = r.force;
+        w->pair_ti[k] = r.torque_i;
+        w->pair_tj[k] = r.torque_j;
     }
+}
+
+// ------------------------------------------------------ contact batches ---
+//
+// The explicit integration's pairs go through a batch: the touching pairs of
+// a stretch of rows are gathered into structure-of-arrays form, the contact
+// law runs over the batch in a loop the compiler vectorises (pair_contact is
+// branch-free; -fno-trapping-math lets it evaluate both sides of a select),
+// and the results are added to the granules in the pairs' own order — the
+// serial order, so the sums and the final state are bitwise those of the
+// one-pair-at-a-time loop.
+#define DEM_BATCH 32
+
+typedef struct contact_batch {
+    int count;
+    uint32_t i[DEM_BATCH], j[DEM_BATCH];
+    size_t k[DEM_BATCH];
+    double d[3][DEM_BATCH];
+    double rad[2][DEM_BATCH], inv_mass[2][DEM_BATCH];
+    double vel[6][DEM_BATCH], omg[6][DEM_BATCH]; // x y z of i, then of j
+    double hist[6][DEM_BATCH];
+    double f[3][DEM_BATCH], ti[3][DEM_BATCH], tj[3][DEM_BATCH];
+} contact_batch;
+
+static DEM_ALWAYS_INLINE void batch_put_side(contact_batch *restrict b, int e, int side, const pair_side *s)
+{
+    b->rad[side][e] = s->rad;
+    b->inv_mass[side][e] = s->inv_mass;
+    const double v[3] = {s->vel.x, s->vel.y, s->vel.z}, o[3] = {s->omg.x, s->omg.y, s->omg.z};
+    for (int q = 0; q < 3; ++q) b->vel[3 * side + q][e] = v[q], b->omg[3 * side + q][e] = o[q];
+}
+
+static DEM_ALWAYS_INLINE pair_side batch_side(const contact_batch *restrict b, int e, int side)
+{
+    const int o = 3 * side;
+    return (pair_side){dem_v3(b->vel[o][e], b->vel[o + 1][e], b->vel[o + 2][e]),
+                       dem_v3(b->omg[o][e], b->omg[o + 1][e], b->omg[o + 2][e]), b->rad[side][e],
+                       b->inv_mass[side][e]};
+}
+
+// The law over the whole batch: one iteration per contact, no branches, no
+// dependence between iterations.
+static DEM_ALWAYS_INLINE void batch_compute(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
+{
+    const int hl = dem_history_len(mask), count = b->count;
+#pragma GCC ivdep
+    for (int e = 0; e < count; ++e) {
+        const pair_side si = batch_side(b, e, 0), sj = batch_side(b, e, 1);
+        double h[6] = {0, 0, 0, 0, 0, 0};
+        for (int q = 0; q < hl; ++q) h[q] = b->hist[q][e];
+        const pair_result r = pair_contact(c, dem_v3(b->d[0][e], b->d[1][e], b->d[2][e]), &si, &sj, h, mask);
+        for (int q = 0; q < hl; ++q) b->hist[q][e] = h[q];
+        b->f[0][e] = r.force.x, b->f[1][e] = r.force.y, b->f[2][e] = r.force.z;
+        b->ti[0][e] = r.torque_i.x, b->ti[1][e] = r.torque_i.y, b->ti[2][e] = r.torque_i.z;
+        b->tj[0][e] = r.torque_j.x, b->tj[1][e] = r.torque_j.y, b->tj[2][e] = r.torque_j.z;
+    }
+}
+
+// The batch kernel is built twice, for the x86-64 baseline (two contacts per
+// SSE instruction) and for x86-64-v3 (AVX2: four), and the loader picks the
+// one this CPU runs (GCC function multi-versioning). The engine is built
+// with -ffp-contract=off, so the v3 build uses no fused multiply-add: both
+// are the same arithmetic and results do not depend on the machine.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define DEM_MULTIVERSION __attribute__((target_clones("arch=x86-64-v3", "default"), noinline))
+#else
+#define DEM_MULTIVERSION
+#endif
+#define DEM_BATCH_KERNEL(M)                                                                              \
+    DEM_MULTIVERSION static void batch_compute_##M(const pair_ctx *restrict c, contact_batch *restrict b) \
+    {                                                                                                    \
+        batch_compute(c, b, M);                                                                          \
+    }
+DEM_BATCH_KERNEL(0)
+DEM_BATCH_KERNEL(1)
+DEM_BATCH_KERNEL(2)
+DEM_BATCH_KERNEL(3)
+DEM_BATCH_KERNEL(4)
+DEM_BATCH_KERNEL(5)
+DEM_BATCH_KERNEL(6)
+DEM_BATCH_KERNEL(7)
+DEM_BATCH_KERNEL(8)
+DEM_BATCH_KERNEL(9)
+DEM_BATCH_KERNEL(10)
+DEM_BATCH_KERNEL(11)
+DEM_BATCH_KERNEL(12)
+DEM_BATCH_KERNEL(13)
+DEM_BATCH_KERNEL(14)
+DEM_BATCH_KERNEL(15)
+typedef void (*batch_kernel_fn)(const pair_ctx *restrict, contact_batch *restrict);
+static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = {
+    batch_compute_0,  batch_compute_1,  batch_compute_2,  batch_compute_3, batch_compute_4,  batch_compute_5,
+    batch_compute_6,  batch_compute_7,  batch_compute_8,  batch_compute_9, batch_compute_10, batch_compute_11,
+    batch_compute_12, batch_compute_13, batch_compute_14, batch_compute_15};
+
+// Run the batch and add its results in the pairs' order; empties it.
+static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    batch_kernels[mask](c, b);
+    for (int e = 0; e < b->count; ++e) {
+        double *restrict hist = c->hist + b->k[e] * (size_t)hl;
+        for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
+        add_to_pair(c, b->i[e], b->j[e], dem_v3(b->f[0][e], b->f[1][e], b->f[2][e]),
+                    dem_v3(b->ti[0][e], b->ti[1][e], b->ti[2][e]), dem_v3(b->tj[0][e], b->tj[1][e], b->tj[2][e]));
+    }
+    b->count = 0;
+}
+
+// Pair k of row i into the batch if it touches (flushing a full batch);
+// an open pair's springs are reset here.
+static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *restrict c, contact_batch *restrict b,
+                                         size_t i, size_t k, const unsigned mask)
+{
+    const uint32_t j = c->nbr[k];
+    const int hl = dem_history_len(mask);
+    double *restrict hist = c->hist + k * (size_t)hl;
+    dem_vec3 d;
+    if (!pair_touches(w, c, i, j, mask, &d)) {
+        for (int h = 0; h < hl; ++h) hist[h] = 0.0; // a new contact starts unloaded
+        return;
+    }
+    const int e = b->count++;
+    b->i[e] = (uint32_t)i, b->j[e] = j, b->k[e] = k;
+    b->d[0][e] = d.x, b->d[1][e] = d.y, b->d[2][e] = d.z;
+    const pair_side si = side_of(c, i), sj = side_of(c, j);
+    batch_put_side(b, e, 0, &si);
+    batch_put_side(b, e, 1, &sj);
+    for (int q = 0; q < hl; ++q) b->hist[q][e] = hist[q];
+    if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
 // Granules [lo, hi) of thread t of nt: contiguous blocks, so with the
@@ -233,8 +408,16 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
     const size_t *restrict start = w->nl.start;
     memset(w->frc, 0, n * sizeof *w->frc);
     memset(w->trq, 0, n * sizeof *w->trq);
+    if (c.implicit_damping || c.implicit_springs) { // per-pair data for the implicit solves: scalar
+        for (size_t i = 0; i < n; ++i)
+            for (size_t k = start[i]; k < start[i + 1]; ++k) pair_force(w, &c, i, k, mask, DEM_DIRECT);
+        return;
+    }
+    contact_batch b;
+    b.count = 0;
     for (size_t i = 0; i < n; ++i)
-        for (size_t k = start[i]; k < start[i + 1]; ++k) pair_force(w, &c, i, k, mask, DEM_DIRECT);
+        for (size_t k = start[i]; k < start[i + 1]; ++k) batch_pair(w, &c, &b, i, k, mask);
+    batch_flush(&c, &b, mask);
 }
 
 // Threads: each owns a block of granules and adds the pairs inside it
@@ -269,15 +452,22 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
             w->frc[i] = f;
             w->trq[i] = t;
         }
+        const int batched = !c.implicit_damping && !c.implicit_springs;
+        contact_batch b;
+        b.count = 0;
         for (size_t i = lo; i < hi; ++i)
             for (size_t k = start[i]; k < start[i + 1]; ++k) {
-                if (nbr[k] < hi) {
+                if (nbr[k] < hi && batched) {
+                    batch_pair(w, &c, &b, i, k, mask);
+                } else if (nbr[k] < hi) {
                     pair_force(w, &c, i, k, mask, DEM_DIRECT);
-                } else {
+                } else { // the pairs before it first: the serial order
+                    if (batched) batch_flush(&c, &b, mask);
                     w->frc[i] = dem_v3_add(w->frc[i], w->pair_f[k]);
                     w->trq[i] = dem_v3_add(w->trq[i], w->pair_ti[k]);
                 }
             }
+        if (batched) batch_flush(&c, &b, mask);
     }
 }
 
