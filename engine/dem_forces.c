@@ -117,6 +117,7 @@ typedef struct pair_ctx {
     dem_vec3 *frc, *trq;
     const uint32_t *nbr;
     double *hist;
+    const dem_vec3 *slot_f, *slot_ti; // pairs crossing a thread's block: force and torque on i
     dem_contact_coeffs gg;
     double half_lever; // ½ lever_factor: lever arm R − ½h (or R)
     double hist_dt;
@@ -127,7 +128,8 @@ typedef struct pair_ctx {
 
 static inline pair_ctx pair_ctx_make(const dem_world *w)
 {
-    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist, w->gg,
+    return (pair_ctx){w->pos,    w->vel,     w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist,
+                      w->pair_f, w->pair_ti, w->gg,
                       0.5 * w->lever_factor, w->hist_dt, dem_world_period(w), w->def.periodic_axis,
                       w->def.implicit_damping, w->imp.on};
 }
@@ -276,6 +278,10 @@ typedef struct contact_batch {
     int count;
     uint32_t i[DEM_BATCH], j[DEM_BATCH];
     size_t k[DEM_BATCH];
+    // 1: not a contact to compute but a pair crossing the thread's block,
+    // whose slot (computed before the barrier) is added to i at this place
+    // in the order. Its lane of the law runs on neutral data and is dropped.
+    unsigned char slot[DEM_BATCH];
     double d[3][DEM_BATCH];
     double rad[2][DEM_BATCH], inv_mass[2][DEM_BATCH];
     double vel[6][DEM_BATCH], omg[6][DEM_BATCH]; // x y z of i, then of j
@@ -360,12 +366,34 @@ static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_ba
     const int hl = dem_history_len(mask);
     batch_kernels[mask](c, b);
     for (int e = 0; e < b->count; ++e) {
+        if (b->slot[e]) {
+            c->frc[b->i[e]] = dem_v3_add(c->frc[b->i[e]], c->slot_f[b->k[e]]);
+            c->trq[b->i[e]] = dem_v3_add(c->trq[b->i[e]], c->slot_ti[b->k[e]]);
+            continue;
+        }
         double *restrict hist = c->hist + b->k[e] * (size_t)hl;
         for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
         add_to_pair(c, b->i[e], b->j[e], dem_v3(b->f[0][e], b->f[1][e], b->f[2][e]),
                     dem_v3(b->ti[0][e], b->ti[1][e], b->ti[2][e]), dem_v3(b->tj[0][e], b->tj[1][e], b->tj[2][e]));
     }
     b->count = 0;
+}
+
+// The slot of pair k, crossing the thread's block, added to row i in its
+// turn. Not flushing the batch here keeps the batches full near a block's
+// end, where most rows have such a pair.
+static DEM_ALWAYS_INLINE void batch_slot(const pair_ctx *restrict c, contact_batch *restrict b, size_t i, size_t k,
+                                         const unsigned mask)
+{
+    const int e = b->count++;
+    b->slot[e] = 1;
+    b->i[e] = b->j[e] = (uint32_t)i, b->k[e] = k;
+    const pair_side neutral = {{0, 0, 0}, {0, 0, 0}, 1.0, 1.0}; // any finite contact will do
+    b->d[0][e] = 1.0, b->d[1][e] = b->d[2][e] = 0.0;
+    batch_put_side(b, e, 0, &neutral);
+    batch_put_side(b, e, 1, &neutral);
+    for (int q = 0; q < 6; ++q) b->hist[q][e] = 0.0;
+    if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
 // Pair k of row i into the batch if it touches (flushing a full batch);
@@ -382,6 +410,7 @@ static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *
         return;
     }
     const int e = b->count++;
+    b->slot[e] = 0;
     b->i[e] = (uint32_t)i, b->j[e] = j, b->k[e] = k;
     b->d[0][e] = d.x, b->d[1][e] = d.y, b->d[2][e] = d.z;
     const pair_side si = side_of(c, i), sj = side_of(c, j);
@@ -461,8 +490,9 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
                     batch_pair(w, &c, &b, i, k, mask);
                 } else if (nbr[k] < hi) {
                     pair_force(w, &c, i, k, mask, DEM_DIRECT);
-                } else { // the pairs before it first: the serial order
-                    if (batched) batch_flush(&c, &b, mask);
+                } else if (batched) {
+                    batch_slot(&c, &b, i, k, mask);
+                } else {
                     w->frc[i] = dem_v3_add(w->frc[i], w->pair_f[k]);
                     w->trq[i] = dem_v3_add(w->trq[i], w->pair_ti[k]);
                 }
