@@ -459,11 +459,15 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
 // same terms in the same order as pair_loop_serial.
 static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask)
 {
-    const pair_ctx c = pair_ctx_make(w);
-    const size_t *start = w->nl.start;
-    const uint32_t *nbr = w->nl.j;
 #pragma omp parallel
     {
+        // Each thread's own copy: read through the spawning thread's stack
+        // frame, which that thread keeps writing, every pair would share a
+        // cache line with those writes (measured: 2 threads 1.5x one at
+        // N = 100 000, against 1.95x for two separate processes).
+        const pair_ctx c = pair_ctx_make(w);
+        const size_t *start = w->nl.start;
+        const uint32_t *nbr = w->nl.j;
         size_t lo, hi;
         thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
         for (size_t i = lo; i < hi; ++i) // outgoing crossing pairs: into slots
