@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Force and torque evaluation. Each granule–granule pair adds its force and
-// two torques to both granules, rows in ascending order; with threads, each
+// two torques to both granules, rows in ascending order (the explicit
+// integration computes the touching pairs 32 at a time in a vectorised
+// batch, then adds them in that same order: "contact batches"); with threads, each
 // owns a block of granules and only the pairs that cross a block's edge go
 // through per-pair slots (pair_loop_threaded). No two threads write the same
 // memory, and every granule sums its terms in the serial order, so results
