@@ -130,10 +130,20 @@ typedef struct pair_ctx {
 
 static inline pair_ctx pair_ctx_make(const dem_world *w)
 {
-    return (pair_ctx){w->pos,    w->vel,     w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist,
-                      w->pair_f, w->pair_ti, w->gg,
-                      0.5 * w->lever_factor, w->hist_dt, dem_world_period(w), w->def.periodic_axis,
-                      w->def.implicit_damping, w->imp.on};
+    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist, w->pair_f,
+                      w->pair_ti, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
+                      w->def.periodic_axis, w->def.implicit_damping, w->imp.on};
+}
+
+// Whether the pairs go through the contact batch: the implicit integrations
+// keep per-pair data (pair_g, imp.pair) that only the scalar pair_force writes.
+static inline int uses_batch(const pair_ctx *c) { return !c->implicit_damping && !c->implicit_springs; }
+
+// Add the slot of pair k, which crosses a thread's block, to its granule i.
+static DEM_ALWAYS_INLINE void add_slot(const pair_ctx *restrict c, size_t i, size_t k)
+{
+    c->frc[i] = dem_v3_add(c->frc[i], c->slot_f[k]);
+    c->trq[i] = dem_v3_add(c->trq[i], c->slot_ti[k]);
 }
 
 // Minimum image of one component along a period of length len.
@@ -378,8 +388,7 @@ static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_ba
     batch_kernels[mask](c, b);
     for (int e = 0; e < b->count; ++e) {
         if (b->slot[e]) {
-            c->frc[b->i[e]] = dem_v3_add(c->frc[b->i[e]], c->slot_f[b->k[e]]);
-            c->trq[b->i[e]] = dem_v3_add(c->trq[b->i[e]], c->slot_ti[b->k[e]]);
+            add_slot(c, b->i[e], b->k[e]);
             continue;
         }
         double *restrict hist = c->hist + b->k[e] * (size_t)hl;
@@ -448,7 +457,7 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
     const size_t *restrict start = w->nl.start;
     memset(w->frc, 0, n * sizeof *w->frc);
     memset(w->trq, 0, n * sizeof *w->trq);
-    if (c.implicit_damping || c.implicit_springs) { // per-pair data for the implicit solves: scalar
+    if (!uses_batch(&c)) {
         for (size_t i = 0; i < n; ++i)
             for (size_t k = start[i]; k < start[i + 1]; ++k) pair_force(w, &c, i, k, mask, DEM_DIRECT);
         return;
@@ -496,7 +505,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
             w->frc[i] = f;
             w->trq[i] = t;
         }
-        const int batched = !c.implicit_damping && !c.implicit_springs;
+        const int batched = uses_batch(&c);
         contact_batch b;
         b.count = 0;
         for (size_t i = lo; i < hi; ++i)
@@ -508,8 +517,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
                 } else if (batched) {
                     batch_slot(&c, &b, i, k, mask);
                 } else {
-                    w->frc[i] = dem_v3_add(w->frc[i], w->pair_f[k]);
-                    w->trq[i] = dem_v3_add(w->trq[i], w->pair_ti[k]);
+                    add_slot(&c, i, k);
                 }
             }
         if (batched) batch_flush(&c, &b, mask);

@@ -115,6 +115,18 @@ static void read_shipped(const char *name, char *text, size_t cap)
     fclose(f);
 }
 
+// The shipped config NAME with its first `from` replaced by `to`, into
+// edited[cap]; returns the offset where the edit starts.
+static size_t edit_shipped(const char *name, const char *from, const char *to, char *edited, size_t cap)
+{
+    static char text[1 << 16];
+    read_shipped(name, text, sizeof text);
+    const char *at = strstr(text, from);
+    assert_non_null(at);
+    snprintf(edited, cap, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    return (size_t)(at - text);
+}
+
 static void test_shipped_config_loads(void **state)
 {
     (void)state;
@@ -154,16 +166,13 @@ static void test_shipped_config_loads(void **state)
 static void test_bound_probes_read(void **state)
 {
     (void)state;
-    char path[] = "/tmp/granucal_probes_XXXXXX", err[1024];
-    static char text[1 << 16], edited[1 << 16];
-    read_shipped("calibration.yaml", text, sizeof text);
-    const char *at = strstr(text, "bound_probes: false");
-    assert_non_null(at);
+    char path[] = "/tmp/granucal_probes_XXXXXX", err[1024], to[64];
+    static char edited[1 << 16];
     const char *words[] = {"true", "yes", "no"};
     const int expected[] = {1, 1, 0};
     for (int k = 0; k < 3; ++k) {
-        snprintf(edited, sizeof edited, "%.*sbound_probes: %s%s", (int)(at - text), text, words[k],
-                 at + strlen("bound_probes: false"));
+        snprintf(to, sizeof to, "bound_probes: %s", words[k]);
+        edit_shipped("calibration.yaml", "bound_probes: false", to, edited, sizeof edited);
         close(mkstemp(path));
         write_file(path, edited);
         cal_config *c = cal_config_load(path, "check", err, sizeof err);
@@ -179,15 +188,11 @@ static void test_bound_probes_read(void **state)
 static void expect_config_error(const char *from, const char *to, const char *field)
 {
     char path[] = "/tmp/granucal_cfg_XXXXXX", err[1024], want[1300];
-    static char text[1 << 16];
-    read_shipped("calibration.yaml", text, sizeof text);
-    char *at = strstr(text, from);
-    assert_non_null(at);
     static char edited[1 << 16];
-    snprintf(edited, sizeof edited, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    const size_t at = edit_shipped("calibration.yaml", from, to, edited, sizeof edited);
     // The line the field stands on, at or after the edit.
     const char *leaf = strrchr(field, '.') ? strrchr(field, '.') + 1 : field;
-    const char *mark = strstr(edited + (at - text), leaf);
+    const char *mark = strstr(edited + at, leaf);
     assert_non_null(mark);
     int line = 1;
     for (const char *p = edited; p < mark; ++p) line += *p == '\n';
@@ -263,11 +268,8 @@ static void test_fuzz_findings_refused(void **state)
     expect_config_error("stiffness_tolerance: 0 ", "stiffness_tolerance: inf ", "stiffness_tolerance");
     expect_config_error("max_evaluations: 2\n", "max_evaluations: 2\n    sample_interval: inf\n", "sample_interval");
     // Drum config: inf passed "max_time > 0" (and window, sample_interval, pixel, slice_depth).
-    static char text[1 << 14], edited[1 << 14];
-    read_shipped("drum.yaml", text, sizeof text);
-    const char *at = strstr(text, "max_time: 6.0");
-    assert_non_null(at);
-    snprintf(edited, sizeof edited, "%.*smax_time: inf%s", (int)(at - text), text, at + strlen("max_time: 6.0"));
+    static char edited[1 << 16];
+    edit_shipped("drum.yaml", "max_time: 6.0", "max_time: inf", edited, sizeof edited);
     close(mkstemp(path));
     write_file(path, edited);
     assert_null(exp_drum_config_load(path, 0, NULL, err, sizeof err));
