@@ -58,11 +58,7 @@ static inline void dem_imp_add_block(double *b, dem_vec3 n, double g, double kt,
         }
 }
 
-// Whether the pair loop runs on several threads (blocks of granules) or on one.
-static inline int dem_forces_threaded(const dem_world *w)
-{
-    return w->n >= DEM_OMP_MIN_GRANULES && omp_get_max_threads() > 1;
-}
+int dem_forces_threaded(const dem_world *w) { return w->n >= DEM_OMP_MIN_GRANULES && omp_get_max_threads() > 1; }
 
 static void *grow_to(void *p, size_t bytes, int *fail)
 {
@@ -375,11 +371,12 @@ DEM_BATCH_KERNEL(12)
 DEM_BATCH_KERNEL(13)
 DEM_BATCH_KERNEL(14)
 DEM_BATCH_KERNEL(15)
+// The functions f0 … f15 instantiated for each feature mask, as a table.
+#define DEM_BY_MASK_8(f) {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7}
+#define DEM_BY_MASK_16(f) \
+    {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7, f##8, f##9, f##10, f##11, f##12, f##13, f##14, f##15}
 typedef void (*batch_kernel_fn)(const pair_ctx *restrict, contact_batch *restrict);
-static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = {
-    batch_compute_0,  batch_compute_1,  batch_compute_2,  batch_compute_3, batch_compute_4,  batch_compute_5,
-    batch_compute_6,  batch_compute_7,  batch_compute_8,  batch_compute_9, batch_compute_10, batch_compute_11,
-    batch_compute_12, batch_compute_13, batch_compute_14, batch_compute_15};
+static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(batch_compute_);
 
 // Run the batch and add its results in the pairs' order; empties it.
 static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
@@ -440,9 +437,7 @@ static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *
     if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
-// Granules [lo, hi) of thread t of nt: contiguous blocks, so with the
-// granules sorted along a space-filling curve few pairs cross a block's edge.
-static inline void thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
+void dem_thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
 {
     *lo = n * (size_t)t / (size_t)nt;
     *hi = n * (size_t)(t + 1) / (size_t)nt;
@@ -471,56 +466,84 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
 
 // Threads: each owns a block of granules and adds the pairs inside it
 // directly. A pair reaching past the block's end (rows are sorted by
-// partner, so these close each row) is computed first, into its slots; after
-// a barrier each thread starts its granules from the slots of pairs coming in
-// from lower blocks (the lowest pair indices, so first in the serial order),
-// then walks its rows as the serial loop does, taking the outgoing crossing
-// pairs' part from their slots at the end of each row. Every granule sums the
-// same terms in the same order as pair_loop_serial.
+// partner, so these close each row) is computed first, into its slots
+// (block_crossing_pairs); after a barrier each thread starts its granules
+// from the slots of pairs coming in from lower blocks (the lowest pair
+// indices, so first in the serial order), then walks its rows as the serial
+// loop does, taking the outgoing crossing pairs' part from their slots at the
+// end of each row (block_own_pairs). Every granule sums the same terms in the
+// same order as pair_loop_serial.
+//
+// Each thread works from its own pair_ctx: read through the spawning
+// thread's stack frame, which that thread keeps writing, every pair would
+// share a cache line with those writes (measured: 2 threads 1.5x one at
+// N = 100 000, against 1.95x for two separate processes).
+
+// The pairs of row i (in a block ending at `end`) that reach past the
+// block's end, into their slots.
+static DEM_ALWAYS_INLINE void row_crossing_pairs(dem_world *restrict w, const pair_ctx *restrict c, size_t i,
+                                                 size_t end, const unsigned mask)
+{
+    const size_t *start = w->nl.start;
+    for (size_t k = start[i + 1]; k > start[i] && c->nbr[k - 1] >= end; --k) pair_force(w, c, i, k - 1, mask, DEM_SLOTS);
+}
+
+static DEM_ALWAYS_INLINE void block_crossing_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
+{
+    const pair_ctx c = pair_ctx_make(w);
+    for (size_t i = lo; i < hi; ++i) row_crossing_pairs(w, &c, i, hi, mask);
+}
+
+static DEM_ALWAYS_INLINE void listed_crossing_pairs(dem_world *restrict w, const uint32_t *rows, size_t count,
+                                                    size_t end, const unsigned mask)
+{
+    const pair_ctx c = pair_ctx_make(w);
+    for (size_t r = 0; r < count; ++r) row_crossing_pairs(w, &c, rows[r], end, mask);
+}
+
+static DEM_ALWAYS_INLINE void block_own_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
+{
+    const pair_ctx c = pair_ctx_make(w);
+    const size_t *start = w->nl.start;
+    const uint32_t *nbr = w->nl.j;
+    const size_t first_own_pair = start[lo];
+    for (size_t i = lo; i < hi; ++i) { // incoming crossing pairs: partner rows below lo
+        dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
+        for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1] && w->rev_pair[r] < first_own_pair; ++r) {
+            const size_t k = w->rev_pair[r];
+            f = dem_v3_sub(f, w->pair_f[k]); // Newton's third law
+            t = dem_v3_add(t, w->pair_tj[k]);
+        }
+        w->frc[i] = f;
+        w->trq[i] = t;
+    }
+    const int batched = uses_batch(&c);
+    contact_batch b;
+    b.count = 0;
+    for (size_t i = lo; i < hi; ++i)
+        for (size_t k = start[i]; k < start[i + 1]; ++k) {
+            if (nbr[k] < hi && batched) {
+                batch_pair(w, &c, &b, i, k, mask);
+            } else if (nbr[k] < hi) {
+                pair_force(w, &c, i, k, mask, DEM_DIRECT);
+            } else if (batched) {
+                batch_slot(&c, &b, i, k, mask);
+            } else {
+                add_slot(&c, i, k);
+            }
+        }
+    if (batched) batch_flush(&c, &b, mask);
+}
+
 static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask)
 {
 #pragma omp parallel
     {
-        // Each thread's own copy: read through the spawning thread's stack
-        // frame, which that thread keeps writing, every pair would share a
-        // cache line with those writes (measured: 2 threads 1.5x one at
-        // N = 100 000, against 1.95x for two separate processes).
-        const pair_ctx c = pair_ctx_make(w);
-        const size_t *start = w->nl.start;
-        const uint32_t *nbr = w->nl.j;
         size_t lo, hi;
-        thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
-        for (size_t i = lo; i < hi; ++i) // outgoing crossing pairs: into slots
-            for (size_t k = start[i + 1]; k > start[i] && nbr[k - 1] >= hi; --k)
-                pair_force(w, &c, i, k - 1, mask, DEM_SLOTS);
+        dem_thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
+        block_crossing_pairs(w, lo, hi, mask);
 #pragma omp barrier
-        const size_t first_own_pair = start[lo];
-        for (size_t i = lo; i < hi; ++i) { // incoming crossing pairs: partner rows below lo
-            dem_vec3 f = dem_v3(0, 0, 0), t = dem_v3(0, 0, 0);
-            for (size_t r = w->rev_start[i]; r < w->rev_start[i + 1] && w->rev_pair[r] < first_own_pair; ++r) {
-                const size_t k = w->rev_pair[r];
-                f = dem_v3_sub(f, w->pair_f[k]); // Newton's third law
-                t = dem_v3_add(t, w->pair_tj[k]);
-            }
-            w->frc[i] = f;
-            w->trq[i] = t;
-        }
-        const int batched = uses_batch(&c);
-        contact_batch b;
-        b.count = 0;
-        for (size_t i = lo; i < hi; ++i)
-            for (size_t k = start[i]; k < start[i + 1]; ++k) {
-                if (nbr[k] < hi && batched) {
-                    batch_pair(w, &c, &b, i, k, mask);
-                } else if (nbr[k] < hi) {
-                    pair_force(w, &c, i, k, mask, DEM_DIRECT);
-                } else if (batched) {
-                    batch_slot(&c, &b, i, k, mask);
-                } else {
-                    add_slot(&c, i, k);
-                }
-            }
-        if (batched) batch_flush(&c, &b, mask);
+        block_own_pairs(w, lo, hi, mask);
     }
 }
 
@@ -581,11 +604,35 @@ static DEM_ALWAYS_INLINE void wall_loop(dem_world *restrict w, const dem_wall *w
     for (size_t k = 0; k < n; ++k) wall_force(w, wall, near[k], mask);
 }
 
-// One specialised function per feature mask; the switch picks it per scene.
-#define DEM_PAIR_LOOP(M) \
-    static void pair_loop_##M(dem_world *w) { pair_loop(w, M); }
-#define DEM_WALL_LOOP(M) \
-    static void wall_loop_##M(dem_world *w, const dem_wall *wall) { wall_loop(w, wall, M); }
+// Granules [lo, hi) of one thread's block that are near the wall (the near
+// list is in ascending order).
+static DEM_ALWAYS_INLINE void wall_block(dem_world *restrict w, const dem_wall *wall, size_t lo, size_t hi,
+                                         const unsigned mask)
+{
+    const uint32_t *near = wall->near;
+    size_t a = 0, b = wall->near_count;
+    while (a < b) { // first near granule at or above lo
+        const size_t m = a + (b - a) / 2;
+        if (near[m] < lo) a = m + 1;
+        else b = m;
+    }
+    for (size_t k = a; k < wall->near_count && near[k] < hi; ++k) wall_force(w, wall, near[k], mask);
+}
+
+// One specialised function per feature mask; the table picks it per scene.
+#define DEM_PAIR_LOOP(M)                                                                                \
+    static void pair_loop_##M(dem_world *w) { pair_loop(w, M); }                                        \
+    static void crossing_pairs_##M(dem_world *w, const uint32_t *rows, size_t count, size_t end)         \
+    {                                                                                                   \
+        listed_crossing_pairs(w, rows, count, end, M);                                                  \
+    }                                                                                                   \
+    static void own_pairs_##M(dem_world *w, size_t lo, size_t hi) { block_own_pairs(w, lo, hi, M); }
+#define DEM_WALL_LOOP(M)                                                                                \
+    static void wall_loop_##M(dem_world *w, const dem_wall *wall) { wall_loop(w, wall, M); }            \
+    static void wall_block_##M(dem_world *w, const dem_wall *wall, size_t lo, size_t hi)                \
+    {                                                                                                   \
+        wall_block(w, wall, lo, hi, M);                                                                 \
+    }
 #define DEM_FEATURE_LOOP(M) DEM_PAIR_LOOP(M) DEM_WALL_LOOP(M)
 DEM_FEATURE_LOOP(0)
 DEM_FEATURE_LOOP(1)
@@ -605,12 +652,15 @@ DEM_PAIR_LOOP(14)
 DEM_PAIR_LOOP(15)
 
 typedef void (*pair_loop_fn)(dem_world *);
+typedef void (*crossing_pairs_fn)(dem_world *, const uint32_t *, size_t, size_t);
+typedef void (*block_pairs_fn)(dem_world *, size_t, size_t);
 typedef void (*wall_loop_fn)(dem_world *, const dem_wall *);
-static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = {
-    pair_loop_0, pair_loop_1, pair_loop_2,  pair_loop_3,  pair_loop_4,  pair_loop_5,  pair_loop_6,  pair_loop_7,
-    pair_loop_8, pair_loop_9, pair_loop_10, pair_loop_11, pair_loop_12, pair_loop_13, pair_loop_14, pair_loop_15};
-static const wall_loop_fn wall_loops[8] = {wall_loop_0, wall_loop_1, wall_loop_2, wall_loop_3,
-                                           wall_loop_4, wall_loop_5, wall_loop_6, wall_loop_7};
+typedef void (*wall_block_fn)(dem_world *, const dem_wall *, size_t, size_t);
+static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(pair_loop_);
+static const crossing_pairs_fn crossing_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(crossing_pairs_);
+static const block_pairs_fn own_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(own_pairs_);
+static const wall_loop_fn wall_loops[8] = DEM_BY_MASK_8(wall_loop_);
+static const wall_block_fn wall_blocks[8] = DEM_BY_MASK_8(wall_block_);
 
 // Each granule's own dashpots, Σγ n nᵀ over its contacts (implicit dashpot).
 static void gather_damping(dem_world *restrict w)
@@ -624,6 +674,27 @@ static void gather_damping(dem_world *restrict w)
             add_damping(d, w->pair_g[w->rev_pair[r]], w->pair_n[w->rev_pair[r]]);
         for (int c = 0; c < 6; ++c) w->damp[6 * i + c] = d[c];
     }
+}
+
+int dem_forces_blockwise(const dem_world *w) { return !w->def.implicit_damping && !w->def.implicit_springs; }
+
+size_t dem_forces_crossing_rows(const dem_world *w, size_t lo, size_t hi, uint32_t *rows)
+{
+    size_t count = 0;
+    for (size_t i = lo; i < hi; ++i)
+        if (w->nl.start[i + 1] > w->nl.start[i] && w->nl.j[w->nl.start[i + 1] - 1] >= hi) rows[count++] = (uint32_t)i;
+    return count;
+}
+
+void dem_forces_crossing(dem_world *w, const uint32_t *rows, size_t count, size_t end)
+{
+    crossing_pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w, rows, count, end);
+}
+
+void dem_forces_block(dem_world *w, size_t lo, size_t hi)
+{
+    own_pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w, lo, hi);
+    for (int k = 0; k < w->n_walls; ++k) wall_blocks[w->walls[k].features & 7u](w, &w->walls[k], lo, hi);
 }
 
 void dem_forces_compute(dem_world *w)

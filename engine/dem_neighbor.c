@@ -294,12 +294,27 @@ int dem_nl_rebuild(dem_world *w)
     return 0;
 }
 
+static inline double displacement2(const dem_world *w, size_t i)
+{
+    return dem_v3_norm2(dem_world_min_image(w, dem_v3_sub(w->pos[i], w->pos_at_build[i])));
+}
+
 double dem_nl_max_displacement2(const dem_world *w)
 {
     double m = 0;
 #pragma omp parallel for reduction(max : m) schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
     for (size_t i = 0; i < w->n; ++i) {
-        double d2 = dem_v3_norm2(dem_world_min_image(w, dem_v3_sub(w->pos[i], w->pos_at_build[i])));
+        const double d2 = displacement2(w, i);
+        m = d2 > m ? d2 : m;
+    }
+    return m;
+}
+
+double dem_nl_max_displacement2_range(const dem_world *w, size_t lo, size_t hi)
+{
+    double m = 0;
+    for (size_t i = lo; i < hi; ++i) {
+        const double d2 = displacement2(w, i);
         m = d2 > m ? d2 : m;
     }
     return m;

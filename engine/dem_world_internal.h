@@ -152,10 +152,29 @@ static inline double dem_world_period(const dem_world *w)
 int dem_nl_rebuild(dem_world *w);
 void dem_nl_free(dem_neighbor_list *nl);
 double dem_nl_max_displacement2(const dem_world *w);
+// The same over granules [lo, hi) only, for a caller already on a thread.
+double dem_nl_max_displacement2_range(const dem_world *w, size_t lo, size_t hi);
 dem_vec3 dem_world_min_image(const dem_world *w, dem_vec3 d);
 
 // dem_forces.c
 void dem_forces_compute(dem_world *w);
+// Granules [lo, hi) of thread t of nt: contiguous blocks, so with the
+// granules sorted along a space-filling curve few pairs cross a block's edge.
+void dem_thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi);
+// Whether the force evaluation and the step run on several threads.
+int dem_forces_threaded(const dem_world *w);
+// The force evaluation split by thread blocks, for the step loop that runs
+// on a team of threads in one parallel region (dem_world_step): whether this
+// world can be evaluated that way (the explicit integration); the rows of
+// block [lo, hi) with a pair reaching past hi, into `rows` (their count); on
+// any threads, dem_forces_crossing for such rows of a block ending at `end`
+// (each row on one thread), computing those pairs into their slots; then a
+// barrier, and on each thread dem_forces_block (the block's other pairs and
+// its walls). Bitwise the same forces as dem_forces_compute.
+int dem_forces_blockwise(const dem_world *w);
+size_t dem_forces_crossing_rows(const dem_world *w, size_t lo, size_t hi, uint32_t *rows);
+void dem_forces_crossing(dem_world *w, const uint32_t *rows, size_t count, size_t end);
+void dem_forces_block(dem_world *w, size_t lo, size_t hi);
 // Implicit springs: solve (M + Δt C + Δt²/4 K_t) a = F + M g for every
 // granule's rates a (into w->acc); 0 on success, 1 out of memory.
 int dem_implicit_solve(dem_world *w);

@@ -9,7 +9,8 @@
 //  4. an undamped (ξ = 0) closed box run long: energy bounded, no crossing;
 //  5. faults injected on purpose (NaN, infinity, launch out, placed out):
 //     caught by the next dem_world_step, with the granule id, step and reason;
-//  6. determinism: the same seed bitwise, 1 against 2 OpenMP threads;
+//  6. determinism: the same seed bitwise, 1 against 2 OpenMP threads, and
+//     the same faults on both;
 //  7. the drum at 116 rpm with (μ_s, μ_r) = (0.27, 0.5), the pair the paper
 //     could not bring to steady state: finite, every granule in the drum.
 // Beds are small (tens to hundreds of granules) so the file runs in about a
@@ -707,6 +708,65 @@ static int bitwise_equal(const dem_world *a, const dem_world *b)
            memcmp(ga.omega, gb.omega, bytes) == 0;
 }
 
+// Step a copy of `bed`, changed by `inject`, on `threads` threads; its
+// status, and its error message into msg.
+static dem_status fault_on_threads(const dem_world *bed, int threads, void (*inject)(dem_world *), char *msg,
+                                   size_t len)
+{
+    dem_world *w = dem_world_clone(bed);
+    assert_non_null(w);
+    omp_set_num_threads(threads);
+    inject(w);
+    const dem_status st = dem_world_step(w, 5000);
+    snprintf(msg, len, "%s", dem_world_error(w));
+    dem_world_destroy(w);
+    return st;
+}
+
+// The top granule at 50 m/s upwards: it leaves the domain after a drift.
+static void launch_top_granule(dem_world *w)
+{
+    dem_world_set_granule_velocity(w, highest_granule(w), dem_v3(0, 50, 0), dem_v3(0, 0, 0));
+}
+
+// A granule in free space spinning at DBL_MAX rad/s per component: finite at
+// the call's start, no contact to turn the spin into forces, and the kick's
+// finiteness test (one sum of the components) overflows to infinity.
+static void spin_free_granule(dem_world *w)
+{
+    const dem_vec3 zero = dem_v3(0, 0, 0), huge = dem_v3(DBL_MAX, DBL_MAX, DBL_MAX);
+    assert_true(dem_world_granules(w).position[highest_granule(w)].y < 0.1); // the bed is far below
+    assert_true(dem_world_add_granule(w, dem_v3(0, 0.15, 0), zero, huge, 0.5 * D50, RHO) >= 0);
+}
+
+// With 2 threads the steps run in one parallel region (dem_world.c, "the step
+// team"), which stops after the drift when a granule escaped and after the
+// kick when a state is not finite: the same fault, granule, step and state as
+// on one thread.
+static void expect_same_fault_on_2_threads(const dem_world *bed)
+{
+    const struct {
+        const char *label;
+        void (*inject)(dem_world *);
+        dem_status want;
+    } cases[] = {
+        {"launched at 50 m/s", launch_top_granule, DEM_ERR_ESCAPED},
+        {"free granule spinning at DBL_MAX", spin_free_granule, DEM_ERR_NONFINITE},
+    };
+    const int saved = omp_get_max_threads();
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
+        char m1[512], m2[512];
+        const dem_status s1 = fault_on_threads(bed, 1, cases[k].inject, m1, sizeof m1);
+        const dem_status s2 = fault_on_threads(bed, 2, cases[k].inject, m2, sizeof m2);
+        printf("  %s: 1 thread status %d: %s\n  %*s 2 threads status %d: %s\n", cases[k].label, (int)s1, m1,
+               (int)strlen(cases[k].label), "", (int)s2, m2);
+        assert_int_equal(s1, cases[k].want);
+        assert_int_equal(s2, cases[k].want);
+        assert_string_equal(m1, m2);
+    }
+    omp_set_num_threads(saved);
+}
+
 static void test_determinism_and_threads(void **state)
 {
     (void)state;
@@ -738,6 +798,7 @@ static void test_determinism_and_threads(void **state)
            (unsigned long long)steps, dev_threads, t1, t2, (unsigned long long)(c2->rebuilds - a->rebuilds));
     assert_true(c2->rebuilds > a->rebuilds); // the parallel neighbour-list build ran too
     assert_true(bitwise_equal(c1, c2));
+    expect_same_fault_on_2_threads(a);
     dem_world_destroy(a), dem_world_destroy(b), dem_world_destroy(c1), dem_world_destroy(c2);
 }
 
