@@ -4,9 +4,11 @@
 // integration computes the touching pairs 32 at a time in a vectorised
 // batch, then adds them in that same order: "contact batches"); with threads, each
 // owns a block of granules and only the pairs that cross a block's edge go
-// through per-pair slots (pair_loop_threaded). No two threads write the same
-// memory, and every granule sums its terms in the serial order, so results
-// are bitwise identical for any thread count.
+// through per-pair slots (pair_loop_threaded; the step team of dem_world.c
+// runs the same block pieces, dem_forces_crossing and dem_forces_block, inside
+// its one parallel region). No two threads write the same memory, and every
+// granule sums its terms in the serial order, so results are bitwise
+// identical for any thread count.
 //
 // The pair loop and the wall loop are instantiated once per feature mask
 // (DEM_FEATURE_LOOP below): with the mask a constant, the inline kernel of
