@@ -692,8 +692,9 @@ static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, ui
 }
 
 // Up to `steps` whole steps on the team; 0 steps and TEAM_DONE if its
-// scratch could not be had (the ordinary step then goes on). Allocated once
-// per region, i.e. per list rebuild, not per step.
+// scratch could not be had (the ordinary step then goes on). The scratch and
+// the crossing rows are made once per region, i.e. per call and per list
+// rebuild: not per step, except for a caller that steps one step per call.
 static team_result step_team(dem_world *w, uint64_t steps)
 {
     team_result r = {0, TEAM_DONE, SIZE_MAX};
