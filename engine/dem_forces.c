@@ -439,6 +439,34 @@ static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *
     if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
+// The partner data a pair reads and adds to, asked for DEM_PREFETCH_AHEAD
+// pairs before the loop reaches it. Rows run in spatial order, so their own
+// granules stream in sequence and the hardware prefetcher has them; a
+// partner j > i lies ahead of that stream, often far ahead (a granule's
+// neighbours in the next layer are a layer's worth of granules further on in
+// Morton order), and its seven lines (pos, vel, omg, rad, inv_mass, frc, trq)
+// came in one demand miss after another, each stalling the pair's chain of
+// loads. Into L2 (locality 2), not L1: 96 pairs' partners would crowd L1 out.
+// Read intent also for frc and trq: a line no other core holds comes in
+// exclusive and takes the writes as well; write intent would take the lines
+// of pairs crossing into another thread's block from that thread.
+// Measured, interleaved A/B against no prefetch, 1 thread (commit message):
+// 1.28x at N = 1 000 000; 32, 64 and 128 pairs ahead did less.
+#define DEM_PREFETCH_AHEAD 96
+
+static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_t k, size_t end)
+{
+    if (k + DEM_PREFETCH_AHEAD >= end) return;
+    const uint32_t j = c->nbr[k + DEM_PREFETCH_AHEAD];
+    __builtin_prefetch(c->pos + j, 0, 2);
+    __builtin_prefetch(c->vel + j, 0, 2);
+    __builtin_prefetch(c->omg + j, 0, 2);
+    __builtin_prefetch(c->rad + j, 0, 2);
+    __builtin_prefetch(c->inv_mass + j, 0, 2);
+    __builtin_prefetch(c->frc + j, 0, 2);
+    __builtin_prefetch(c->trq + j, 0, 2);
+}
+
 void dem_thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
 {
     *lo = n * (size_t)t / (size_t)nt;
@@ -454,15 +482,22 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
     const size_t *restrict start = w->nl.start;
     memset(w->frc, 0, n * sizeof *w->frc);
     memset(w->trq, 0, n * sizeof *w->trq);
+    const size_t end = start[n];
     if (!uses_batch(&c)) {
         for (size_t i = 0; i < n; ++i)
-            for (size_t k = start[i]; k < start[i + 1]; ++k) pair_force(w, &c, i, k, mask, DEM_DIRECT);
+            for (size_t k = start[i]; k < start[i + 1]; ++k) {
+                prefetch_partner(&c, k, end);
+                pair_force(w, &c, i, k, mask, DEM_DIRECT);
+            }
         return;
     }
     contact_batch b;
     b.count = 0;
     for (size_t i = 0; i < n; ++i)
-        for (size_t k = start[i]; k < start[i + 1]; ++k) batch_pair(w, &c, &b, i, k, mask);
+        for (size_t k = start[i]; k < start[i + 1]; ++k) {
+            prefetch_partner(&c, k, end);
+            batch_pair(w, &c, &b, i, k, mask);
+        }
     batch_flush(&c, &b, mask);
 }
 
@@ -520,10 +555,12 @@ static DEM_ALWAYS_INLINE void block_own_pairs(dem_world *restrict w, size_t lo, 
         w->trq[i] = t;
     }
     const int batched = uses_batch(&c);
+    const size_t end = start[hi];
     contact_batch b;
     b.count = 0;
     for (size_t i = lo; i < hi; ++i)
         for (size_t k = start[i]; k < start[i + 1]; ++k) {
+            prefetch_partner(&c, k, end);
             if (nbr[k] < hi && batched) {
                 batch_pair(w, &c, &b, i, k, mask);
             } else if (nbr[k] < hi) {
