@@ -17,6 +17,8 @@
 #             file's order (placement order, random in space) against the same
 #             granules sorted by dem_world_sort_spatially (Morton order, what every
 #             other run does), 1 thread, all N (levers.csv)
+#   --flatness only the cost per particle-step against N (granucal, 1 thread,
+#             5 000 to 1 000 000 granules; flat.csv)
 #
 # Order: for each N and thread count, granucal, LIGGGHTS, LAMMPS, repeated R
 # times (A B C A B C ...), so the shared machine's noise hits all three alike;
@@ -28,7 +30,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=${BUILD:-$ROOT/build-bench}
 ARGS="$*"
-QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0 LEVERS=0
+QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0 LEVERS=0 FLATNESS=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) QUICK=1; REPS=2 ;;
@@ -38,7 +40,8 @@ while [ $# -gt 0 ]; do
     --rebuild) REBUILD=1 ;;
     --worktree) WORKTREE=1 ;;
     --levers) LEVERS=1 ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    --flatness) FLATNESS=1 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -95,6 +98,7 @@ vars() { (set +u; . "$BEDS/drum_$1.vars"; eval echo "\$$2"); }
 
 RAW=$OUT/raw.csv LOG=$OUT/runs.log
 [ $LEVERS -eq 1 ] && RAW=$OUT/levers.csv LOG=$OUT/levers.log
+[ $FLATNESS -eq 1 ] && RAW=$OUT/flat.csv LOG=$OUT/flat.log
 echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
 : > "$LOG"
 
@@ -141,6 +145,47 @@ run_peer() {
   echo "$code,$n,$np,$rep,all,$steps,$dt,$loop,$psps,$(tail -1 "$tf" 2>/dev/null),$status,,,,,,$ke" >> "$RAW"
 }
 
+# ---- cost per particle-step against N (granucal, 1 thread), up to 10^6
+# granules: the 5 000 slab tiled 200 times (1.8 m of periodic slice). Every
+# N runs the same number of steps from the same state of the same slab: the
+# drum starts turning at step 0 and its bed loosens (1.75 contacts per granule
+# in the half list at step 20, 1.08 at step 1000, 0.52 at step 2000 at
+# N = 20 000), so a per-N step count would compare different work per
+# particle-step. Sizes alternate within each repetition so the machine's
+# noise hits all alike. flatness_pass DT
+flatness_pass() {
+  local sizes="5000 20000 100000" steps
+  steps=$(steps_for 20000)
+  if [ $QUICK -eq 0 ]; then
+    sizes="$sizes 1000000"
+    [ -f "$BEDS/drum_1000000.vars" ] || "$BENCH" tile "$BEDS/drum_5000.data" "$BEDS" 200 2>> "$OUT/build_beds.log"
+  fi
+  for rep in $(seq 1 "$REPS"); do
+    for n in $sizes; do
+      echo "flatness: N=$n rep $rep/$REPS ($steps steps)" >&2
+      run_granucal "$n" 1 "$rep" all "$steps" "$1"
+      relabel_last flat
+    done
+  done
+}
+
+flatness_table() {
+  python3 - "$1" <<'EOF'
+import csv, statistics as st, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r['variant'] == 'flat' and r['status'] == 'ok']
+print("\n== cost per particle-step against N (granucal, 1 thread, the same steps at every N, medians; "
+      "memory is the process's peak RSS)")
+flat = {}
+for n in sorted({int(r['N']) for r in rows}):
+    rs = [r for r in rows if r['N'] == str(n)]
+    flat[n] = (st.median([1e6 / float(r['psps']) for r in rs]), st.median([float(r['maxrss_kib']) for r in rs]),
+               rs[0]['steps'])
+for n, (us, kib, steps) in sorted(flat.items()):
+    print("  N=%8d: %.3f us per particle-step (%.2fx N=%d), %s steps, peak memory %.1f MiB = %.2f KiB per granule"
+          % (n, us, us / flat[min(flat)][0], min(flat), steps, kib / 1024, kib / n))
+EOF
+}
+
 N0=5000
 DTC=$(vars $N0 DT_CRIT)
 DT_G=$(vars $N0 DT_APRIORI)
@@ -148,6 +193,12 @@ DT_NET=$(vars $N0 DT_NETWORK)
 echo "machine: $(lscpu | awk -F: '/Model name/ {gsub(/^ +/, "", $2); print $2}'), $(nproc) cores; load $(cut -d' ' -f1-3 /proc/loadavg)" | tee "$OUT/machine.txt"
 echo "commit: $(git -C "$ROOT" rev-parse --short HEAD); granucal built from: $GRANUCAL_SRC" | tee -a "$OUT/machine.txt"
 echo "command: tests/bench/vs_peers.sh $ARGS" | tee -a "$OUT/machine.txt"
+
+if [ $FLATNESS -eq 1 ]; then
+  flatness_pass "$DT_G"
+  flatness_table "$RAW"
+  exit 0
+fi
 
 if [ $LEVERS -eq 1 ]; then
   for n in $SIZES; do
@@ -238,21 +289,8 @@ for rep in $(seq 1 "$REPS"); do
   relabel_last all_default_wait
 done
 
-# ---- cost per particle-step against N (granucal, 1 thread), up to 10^6
-# granules: the 5 000 slab tiled 200 times (1.8 m of periodic slice). Sizes
-# alternate within each repetition so the machine's noise hits all alike.
-FLAT_SIZES="5000 20000 100000"
-if [ $QUICK -eq 0 ]; then
-  FLAT_SIZES="$FLAT_SIZES 1000000"
-  [ -f "$BEDS/drum_1000000.vars" ] || "$BENCH" tile "$BEDS/drum_5000.data" "$BEDS" 200 2>> "$OUT/build_beds.log"
-fi
-for rep in $(seq 1 "$REPS"); do
-  for n in $FLAT_SIZES; do
-    echo "flatness: N=$n rep $rep/$REPS" >&2
-    run_granucal "$n" 1 "$rep" all "$(steps_for "$n")" "$DT"
-    relabel_last flat
-  done
-done
+flatness_pass "$DT"
+flatness_table "$RAW"
 
 # ---- 3. table, 1 s of drum, accuracy guard, final line
 python3 - "$RAW" "$BEDS" "$DTC" "$DT_NET" "$BEDMASS" "$D50" <<'EOF'
@@ -320,16 +358,6 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'
             print("granucal 2 threads vs 1, back to back, N=%d, %s waiting: %.3e vs %.3e p-steps/s; ratios %s "
                   "(median %.2f)" % (n, label, med(list(two.values())), med(list(one.values())),
                                      ", ".join("%.2f" % x for x in pairs), med(pairs)))
-
-print("\n== cost per particle-step against N (granucal, 1 thread, medians; memory is the process's peak RSS)")
-flat = {}
-for n in sorted({int(r['N']) for r in rows if r['variant'] == 'flat'}):
-    rs = [r for r in rows if r['variant'] == 'flat' and r['N'] == str(n) and r['status'] == 'ok']
-    if rs: flat[n] = (med([1e6 / num(r['psps']) for r in rs]), med([num(r['maxrss_kib']) for r in rs]))
-base = flat.get(min(flat)) if flat else None
-for n, (us, kib) in sorted(flat.items()):
-    print("  N=%8d: %.3f us per particle-step (%.2fx N=%d), peak memory %.1f MiB = %.2f KiB per granule" % (
-        n, us, us / base[0], min(flat), kib / 1024, kib / n))
 
 print("\n== wall time to simulate 1 s of the drum at N = 20000, at each code's largest step kept at rest")
 for th in ('1', '2'):
