@@ -19,6 +19,8 @@
 #             other run does), 1 thread, all N (levers.csv)
 #   --flatness only the cost per particle-step against N (granucal, 1 thread,
 #             5 000 to 1 000 000 granules; flat.csv)
+#   GRANUCAL_WAIT=default|passive|active (environment): how granucal's threads
+#             wait at a barrier in the main runs (default: OMP_WAIT_POLICY unset)
 #
 # Order: for each N and thread count, granucal, LIGGGHTS, LAMMPS, repeated R
 # times (A B C A B C ...), so the shared machine's noise hits all three alike;
@@ -41,11 +43,15 @@ while [ $# -gt 0 ]; do
     --worktree) WORKTREE=1 ;;
     --levers) LEVERS=1 ;;
     --flatness) FLATNESS=1 ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
   shift
 done
+case ${GRANUCAL_WAIT:-default} in
+  default|passive|active) ;;
+  *) echo "GRANUCAL_WAIT must be default, passive or active, not '$GRANUCAL_WAIT'" >&2; exit 2 ;;
+esac
 OUT=${OUT:-$BUILD/vs_peers}
 mkdir -p "$OUT"
 BEDS=$BUILD/peers
@@ -102,11 +108,23 @@ RAW=$OUT/raw.csv LOG=$OUT/runs.log
 echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
 : > "$LOG"
 
+# How granucal's OpenMP threads wait at a barrier: GRANUCAL_WAIT=default
+# (OMP_WAIT_POLICY unset: libgomp spins a while, then sleeps; what a user
+# gets), passive (sleep at once) or active (spin). The peers' MPI ranks, run
+# with mpi_yield_when_idle, poll and yield while they wait: they spin too.
+wait_env() {
+  case ${GRANUCAL_WAIT:-default} in
+    default) echo "-u OMP_WAIT_POLICY" ;;
+    *) echo "OMP_WAIT_POLICY=$GRANUCAL_WAIT" ;;
+  esac
+}
+
 # run_granucal N THREADS REP VARIANT STEPS DT [RPM [allow]]
 run_granucal() {
   local n=$1 th=$2 rep=$3 var=$4 steps=$5 dt=$6 rpm=${7:-40} allow=${8:-}
   local line
-  line=$(OMP_NUM_THREADS=$th OMP_PROC_BIND=false OMP_WAIT_POLICY=${GRANUCAL_WAIT:-passive} "$BENCH" run "$BEDS/drum_$n.data" "$steps" "$th" "$var" "$dt" "$rpm" $allow 2>>"$LOG") || true
+  # shellcheck disable=SC2046 # wait_env is two words or one, on purpose
+  line=$(env $(wait_env) OMP_NUM_THREADS=$th OMP_PROC_BIND=false "$BENCH" run "$BEDS/drum_$n.data" "$steps" "$th" "$var" "$dt" "$rpm" $allow 2>>"$LOG") || true
   if [ -z "$line" ]; then
     echo "granucal,$n,$th,$rep,$var,$steps,$dt,,,,failed,,,,,," >> "$RAW"; return
   fi
@@ -274,19 +292,19 @@ for n in $SIZES; do
 done
 
 # 2 threads against 1 at the largest N (the issue's target is at 100 000),
-# back to back: 1 thread, 2 threads with passive waiting (the runs above), 2
-# threads with libgomp's default waiting (threads spin a while at each
-# barrier before they sleep: what a user gets without OMP_WAIT_POLICY; on a
-# machine shared beyond its cores spinning takes cycles from others).
+# back to back: 1 thread, then 2 threads under each waiting policy. A step
+# on threads meets three barriers; on this kind of virtual machine a sleeping
+# thread takes long to wake, so passive waiting costs there, while on a
+# machine shared beyond its cores spinning takes cycles from others.
 NW=${SIZES##* }
-echo "N=$NW: granucal on 1 thread, 2 with passive and 2 with default OpenMP waiting, back to back" >&2
+echo "N=$NW: granucal on 1 thread, 2 with default, passive and active OpenMP waiting, back to back" >&2
 for rep in $(seq 1 "$REPS"); do
   run_granucal "$NW" 1 "$rep" all "$(steps_for "$NW")" "$DT"
   relabel_last wait_one_thread
-  run_granucal "$NW" 2 "$rep" all "$(steps_for "$NW")" "$DT"
-  relabel_last all_passive_wait
-  GRANUCAL_WAIT="" run_granucal "$NW" 2 "$rep" all "$(steps_for "$NW")" "$DT"
-  relabel_last all_default_wait
+  for policy in default passive active; do
+    GRANUCAL_WAIT=$policy run_granucal "$NW" 2 "$rep" all "$(steps_for "$NW")" "$DT"
+    relabel_last "all_${policy}_wait"
+  done
 done
 
 flatness_pass "$DT"
@@ -347,11 +365,12 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'
                 sp = med([num(r['psps']) / al[r['rep']] for r in rs if r['rep'] in al])
                 print("granucal %-14s N=%d thr=%s: %.3e p-steps/s, %.2fx all effects on" % (
                     v, n, th, med([num(r['psps']) for r in rs]), sp))
-    # 1 thread and both wait policies ran back to back: ratios within each
+    # 1 thread and the three wait policies ran back to back: ratios within each
     # repetition, not against a main run of minutes before.
     by_rep = lambda v, th: {r['rep']: num(r['psps']) for r in sel(N=str(n), threads=th, variant=v) if r['status'] == 'ok'}
     one = by_rep('wait_one_thread', '1')
-    for v, label in (('all_passive_wait', 'passive'), ('all_default_wait', 'default (spin, then sleep)')):
+    for v, label in (('all_default_wait', 'default (spin, then sleep)'), ('all_passive_wait', 'passive'),
+                     ('all_active_wait', 'active (spin)')):
         two = by_rep(v, '2')
         pairs = [two[k] / one[k] for k in two if k in one]
         if pairs:
