@@ -451,8 +451,8 @@ static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *
 // exclusive and takes the writes as well; write intent would take the lines
 // of pairs crossing into another thread's block from that thread.
 // Measured, interleaved A/B against no prefetch, 1 thread (commit d0b7a77):
-// 1.28x at N = 1 000 000, 1.24x at 100 000, none at 20 000 and below (the
-// bed in the last-level cache); 24, 48, 64 and 128 pairs ahead did less.
+// 1.28x at N = 1 000 000, 1.24x at 100 000, 0.97-1.09x at 20 000, none at
+// 5 000 (in cache); 24, 48, 64 and 128 pairs ahead did less.
 #define DEM_PREFETCH_AHEAD 96
 
 static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_t k, size_t end)
