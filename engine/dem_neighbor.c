@@ -4,6 +4,7 @@
 // by partner index so forces never depend on the order cells are visited,
 // and contact history is carried from the old list to the new by merging
 // sorted rows.
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -294,28 +295,24 @@ int dem_nl_rebuild(dem_world *w)
     return 0;
 }
 
-static inline double displacement2(const dem_world *w, size_t i)
-{
-    return dem_v3_norm2(dem_world_min_image(w, dem_v3_sub(w->pos[i], w->pos_at_build[i])));
-}
-
-double dem_nl_max_displacement2(const dem_world *w)
+double dem_nl_max_displacement2_range(const dem_world *w, size_t lo, size_t hi)
 {
     double m = 0;
-#pragma omp parallel for reduction(max : m) schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
-    for (size_t i = 0; i < w->n; ++i) {
-        const double d2 = displacement2(w, i);
+    for (size_t i = lo; i < hi; ++i) {
+        const double d2 = dem_v3_norm2(dem_world_min_image(w, dem_v3_sub(w->pos[i], w->pos_at_build[i])));
         m = d2 > m ? d2 : m;
     }
     return m;
 }
 
-double dem_nl_max_displacement2_range(const dem_world *w, size_t lo, size_t hi)
+double dem_nl_max_displacement2(const dem_world *w)
 {
     double m = 0;
-    for (size_t i = lo; i < hi; ++i) {
-        const double d2 = displacement2(w, i);
-        m = d2 > m ? d2 : m;
+#pragma omp parallel reduction(max : m) if (w->n >= DEM_OMP_MIN_GRANULES)
+    {
+        size_t lo, hi;
+        dem_thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
+        m = dem_nl_max_displacement2_range(w, lo, hi);
     }
     return m;
 }
