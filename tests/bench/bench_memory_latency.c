@@ -4,7 +4,8 @@
 // lines (every load depends on the one before, and no prefetcher can guess
 // the next line). It tells where this machine's fast cache ends, which is
 // what vs_peers.sh's cost-against-N pass runs into: a granule's hot data is
-// about 400 bytes, so the bed outgrows a cache of C bytes near N = C / 400.
+// about 400 bytes (counted from the arrays a step touches, not measured), so
+// the bed outgrows a cache of C bytes near N = C / 400.
 //
 //   build/tests/bench_memory_latency [largest MiB (default 128)] [loads per size (default 2e7)]
 #include <stdint.h>
