@@ -251,7 +251,7 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *
         // Open contact: springs forget (a new contact starts unloaded).
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         if (!direct) w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = dem_v3(0, 0, 0);
-        if (c->implicit_damping) w->pair_g[k] = 0.0;
+        if (c->implicit_damping) w->pair_g[k] = 0.0, w->pair_n[k] = dem_v3(0, 0, 0); // gather_damping reads both
         if (c->implicit_springs) w->imp.pair[k] = (dem_imp_contact){{0, 0, 0}, 0, 0, 0, 0, 0, 0};
         return;
     }

@@ -4,6 +4,7 @@
 // by partner index so forces never depend on the order cells are visited,
 // and contact history is carried from the old list to the new by merging
 // sorted rows.
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -162,6 +163,22 @@ static void carry_history(dem_neighbor_list *nw, const dem_neighbor_list *old, s
     }
 }
 
+// Fresh per-pair scratch starts as NaN, not as whatever the allocator
+// returned: every evaluation must write a pair's entries before anything
+// reads them, and a path that does not (an open pair's normal was once left
+// unwritten under the implicit dashpot, and 0 × a stale NaN made a granule
+// non-finite only when the heap happened to hold one) then fails at once,
+// named by the engine's non-finite check, instead of by chance.
+static void poison_pair_scratch(dem_world *w, size_t from, size_t to)
+{
+    const double nan = NAN;
+    const dem_vec3 nan3 = dem_v3(nan, nan, nan);
+    for (size_t k = from; k < to; ++k) {
+        w->pair_f[k] = w->pair_ti[k] = w->pair_tj[k] = w->pair_n[k] = nan3;
+        w->pair_g[k] = nan;
+    }
+}
+
 static int ensure_pairs(dem_world *w, size_t pairs)
 {
     dem_neighbor_list *nl = &w->nl;
@@ -191,6 +208,7 @@ static int ensure_pairs(dem_world *w, size_t pairs)
         double *pg = pn ? realloc(w->pair_g, cap * sizeof *pg) : NULL;
         if (pg) w->pair_g = pg;
         if (!pg) return 1;
+        poison_pair_scratch(w, w->pair_cap, cap);
         w->pair_cap = cap;
     }
     return 0;

@@ -376,8 +376,9 @@ static int emit(dem_world *w, const scene *sp, const char *outdir, double t0)
         for (int j = 1; j <= nt; ++j) {
             int wall = i == nt || j == nt;
             const dem_contact_params *p = wall ? &s.gw : &s.gg;
-            double mi = rep[i == nt ? j : i], mj = rep[j == nt ? i : j];
-            if (i == nt && j == nt) mi = mj = rep[1];
+            // A wall side takes its partner's bin; wall–wall (never in contact) takes bin 1.
+            const int bi = i < nt ? i : j < nt ? j : 1, bj = j < nt ? j : i < nt ? i : 1;
+            double mi = rep[bi], mj = rep[bj];
             double mstar = wall ? (i == nt ? mj : mi) : mi * mj / (mi + mj);
             kn[i][j] = p->k_n, gam[i][j] = 2 * p->xi * sqrt(p->k_n / mstar), mu[i][j] = p->mu_s, mur[i][j] = p->mu_r;
         }
