@@ -115,7 +115,7 @@ typedef struct pair_ctx {
     const dem_vec3 *pos, *vel, *omg;
     const double *rad, *inv_mass;
     dem_vec3 *frc, *trq;
-    const uint32_t *nbr;
+    const uint32_t *nbr, *row; // partner and row (granule i) of each pair
     double *hist;
     const dem_vec3 *slot_f, *slot_ti; // pairs crossing a thread's block: force and torque on i
     dem_contact_coeffs gg;
@@ -128,8 +128,8 @@ typedef struct pair_ctx {
 
 static inline pair_ctx pair_ctx_make(const dem_world *w)
 {
-    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.hist, w->pair_f,
-                      w->pair_ti, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
+    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.row, w->nl.hist,
+                      w->pair_f, w->pair_ti, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
                       w->def.periodic_axis, w->def.implicit_damping, w->imp.on};
 }
 
@@ -415,30 +415,6 @@ static DEM_ALWAYS_INLINE void batch_slot(const pair_ctx *restrict c, contact_bat
     if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
-// Pair k of row i into the batch if it touches (flushing a full batch);
-// an open pair's springs are reset here.
-static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *restrict c, contact_batch *restrict b,
-                                         size_t i, size_t k, const unsigned mask)
-{
-    const uint32_t j = c->nbr[k];
-    const int hl = dem_history_len(mask);
-    double *restrict hist = c->hist + k * (size_t)hl;
-    dem_vec3 d;
-    if (!pair_touches(w, c, i, j, mask, &d)) {
-        for (int h = 0; h < hl; ++h) hist[h] = 0.0; // a new contact starts unloaded
-        return;
-    }
-    const int e = b->count++;
-    b->slot[e] = 0;
-    b->i[e] = (uint32_t)i, b->j[e] = j, b->k[e] = k;
-    b->d[0][e] = d.x, b->d[1][e] = d.y, b->d[2][e] = d.z;
-    const pair_side si = side_of(c, i), sj = side_of(c, j);
-    batch_put_side(b, e, 0, &si);
-    batch_put_side(b, e, 1, &sj);
-    for (int q = 0; q < hl; ++q) b->hist[q][e] = hist[q];
-    if (b->count == DEM_BATCH) batch_flush(c, b, mask);
-}
-
 // The partner data a pair reads and adds to, asked for DEM_PREFETCH_AHEAD
 // pairs before the loop reaches it. Rows run in spatial order, so their own
 // granules stream in sequence and the hardware prefetcher has them; a
@@ -468,6 +444,60 @@ static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_
     __builtin_prefetch(c->trq + j, 0, 2);
 }
 
+// Touching pair k (i, j, separation d) into the batch, flushing it when full.
+static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_batch *restrict b, size_t i,
+                                            uint32_t j, size_t k, dem_vec3 d, const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    const double *restrict hist = c->hist + k * (size_t)hl;
+    const int e = b->count++;
+    b->slot[e] = 0;
+    b->i[e] = (uint32_t)i, b->j[e] = j, b->k[e] = k;
+    b->d[0][e] = d.x, b->d[1][e] = d.y, b->d[2][e] = d.z;
+    const pair_side si = side_of(c, i), sj = side_of(c, j);
+    batch_put_side(b, e, 0, &si);
+    batch_put_side(b, e, 1, &sj);
+    for (int q = 0; q < hl; ++q) b->hist[q][e] = hist[q];
+    if (b->count == DEM_BATCH) batch_flush(c, b, mask);
+}
+
+// Pairs k0 … k1−1 into the batch, in their order: the touching ones as
+// contacts, those reaching past `hi` (the end of a thread's block) as slot
+// entries; the others are open, and their springs are reset (a new contact
+// starts unloaded). Contacts and near misses interleave in a bed, so a
+// branch on the touch test is mispredicted about as often as not, and so is
+// the end of a row's few pairs. Instead the pairs are walked in fixed pieces
+// across rows (each pair knows its row), and each pair's index is written to
+// both lists, of which only the one it belongs to advances.
+#define PAIR_PIECE 32
+static DEM_ALWAYS_INLINE void batch_pairs(dem_world *restrict w, const pair_ctx *restrict c, contact_batch *restrict b,
+                                          size_t k0, size_t k1, size_t hi, const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    const uint32_t *restrict row = c->row, *restrict nbr = c->nbr;
+    for (size_t p0 = k0; p0 < k1; p0 += PAIR_PIECE) {
+        const size_t p1 = p0 + PAIR_PIECE < k1 ? p0 + PAIR_PIECE : k1;
+        size_t take[PAIR_PIECE], open[PAIR_PIECE];
+        dem_vec3 sep[PAIR_PIECE];
+        unsigned char crossing[PAIR_PIECE];
+        int nt = 0, no = 0;
+        for (size_t k = p0; k < p1; ++k) {
+            prefetch_partner(c, k, k1);
+            dem_vec3 d;
+            const int x = nbr[k] >= hi, in = pair_touches(w, c, row[k], nbr[k], mask, &d) | x;
+            take[nt] = k, sep[nt] = d, crossing[nt] = (unsigned char)x, open[no] = k;
+            nt += in, no += !in;
+        }
+        for (int o = 0; o < no; ++o)
+            for (int h = 0; h < hl; ++h) c->hist[open[o] * (size_t)hl + h] = 0.0;
+        for (int t = 0; t < nt; ++t) {
+            const size_t k = take[t];
+            if (crossing[t]) batch_slot(c, b, row[k], k, mask);
+            else batch_contact(c, b, row[k], nbr[k], k, sep[t], mask);
+        }
+    }
+}
+
 void dem_thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
 {
     *lo = n * (size_t)t / (size_t)nt;
@@ -494,11 +524,7 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
     }
     contact_batch b;
     b.count = 0;
-    for (size_t i = 0; i < n; ++i)
-        for (size_t k = start[i]; k < start[i + 1]; ++k) {
-            prefetch_partner(&c, k, end);
-            batch_pair(w, &c, &b, i, k, mask);
-        }
+    batch_pairs(w, &c, &b, 0, end, n, mask);
     batch_flush(&c, &b, mask);
 }
 
@@ -555,24 +581,20 @@ static DEM_ALWAYS_INLINE void block_own_pairs(dem_world *restrict w, size_t lo, 
         w->frc[i] = f;
         w->trq[i] = t;
     }
-    const int batched = uses_batch(&c);
     const size_t end = start[hi];
+    if (!uses_batch(&c)) {
+        for (size_t i = lo; i < hi; ++i)
+            for (size_t k = start[i]; k < start[i + 1]; ++k) {
+                prefetch_partner(&c, k, end);
+                if (nbr[k] < hi) pair_force(w, &c, i, k, mask, DEM_DIRECT);
+                else add_slot(&c, i, k);
+            }
+        return;
+    }
     contact_batch b;
     b.count = 0;
-    for (size_t i = lo; i < hi; ++i)
-        for (size_t k = start[i]; k < start[i + 1]; ++k) {
-            prefetch_partner(&c, k, end);
-            if (nbr[k] < hi && batched) {
-                batch_pair(w, &c, &b, i, k, mask);
-            } else if (nbr[k] < hi) {
-                pair_force(w, &c, i, k, mask, DEM_DIRECT);
-            } else if (batched) {
-                batch_slot(&c, &b, i, k, mask);
-            } else {
-                add_slot(&c, i, k);
-            }
-        }
-    if (batched) batch_flush(&c, &b, mask);
+    batch_pairs(w, &c, &b, start[lo], end, hi, mask);
+    batch_flush(&c, &b, mask);
 }
 
 static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask)

@@ -187,9 +187,11 @@ static int ensure_pairs(dem_world *w, size_t pairs)
         size_t cap = pairs + pairs / 4 + 16;
         uint32_t *j = realloc(nl->j, cap * sizeof *j);
         if (j) nl->j = j;
-        double *h = j ? realloc(nl->hist, cap * hl * sizeof *h) : NULL;
+        uint32_t *row = j ? realloc(nl->row, cap * sizeof *row) : NULL;
+        if (row) nl->row = row;
+        double *h = row ? realloc(nl->hist, cap * hl * sizeof *h) : NULL;
         if (h) nl->hist = h;
-        if (!j || !h) return 1;
+        if (!h) return 1;
         nl->cap = cap;
         nl->hist_cap = cap * hl;
     }
@@ -300,6 +302,7 @@ int dem_nl_rebuild(dem_world *w)
         for (size_t i = 0; i < n; ++i) {
             scan_row(w, &g, i, nl->j + start[i]);
             sort_row(nl->j + start[i], start[i + 1] - start[i]);
+            for (size_t k = start[i]; k < start[i + 1]; ++k) nl->row[k] = (uint32_t)i;
             carry_history(nl, &w->nl_old, old_rows, i);
         }
         fail = build_reverse(w);
@@ -339,6 +342,7 @@ void dem_nl_free(dem_neighbor_list *nl)
 {
     free(nl->start);
     free(nl->j);
+    free(nl->row);
     free(nl->hist);
     memset(nl, 0, sizeof *nl);
 }

@@ -17,6 +17,7 @@
 typedef struct dem_neighbor_list {
     size_t *start;   // n + 1 row offsets
     uint32_t *j;     // partner of each pair
+    uint32_t *row;   // row of each pair (its granule i): pair loops walk pieces of pairs across rows
     double *hist;    // hist_len doubles per pair
     size_t count, cap;
     size_t hist_cap; // doubles allocated in hist
