@@ -1028,10 +1028,11 @@ static void test_determinism(void **state)
 // every step, and it must add nothing. Velocities stay bitwise what they
 // were (the kick adds 0 · Δt/m) and centres follow x0 + v t. Run under the
 // explicit law, the implicit dashpot and the implicit springs: each keeps its
-// own per-pair data, and the engine fills fresh per-pair storage with NaN, so
-// an integration that reads an open pair's entry before writing it fails
-// here instead of by chance (the implicit dashpot once left an open pair's
-// normal unwritten; found when a pour turned non-finite).
+// own per-pair data. In the sanitizer build (GRANUCAL_POISON_SCRATCH) the
+// engine fills fresh per-pair storage with NaN, so an integration that reads
+// an open pair's entry before writing it fails here at once, not by chance
+// (the implicit dashpot once left an open pair's normal unwritten; found
+// when a pour turned non-finite).
 static void free_flight_run(int implicit_damping, int implicit_springs, const char *label)
 {
     const double R = 5e-4, gap = 0.05 * R, v = 1e-3;
