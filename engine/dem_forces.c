@@ -461,6 +461,19 @@ static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_
     if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
+// Pair k of row i into the batch if it touches (flushing a full batch);
+// an open pair's springs are reset here. A branch on the touch test: the
+// small lists' loop (see DEM_BRANCH_FREE_MIN_PAIRS).
+static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *restrict c, contact_batch *restrict b,
+                                         size_t i, size_t k, const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    dem_vec3 d;
+    if (pair_touches(w, c, i, c->nbr[k], mask, &d)) batch_contact(c, b, i, c->nbr[k], k, d, mask);
+    else
+        for (int h = 0; h < hl; ++h) c->hist[k * (size_t)hl + h] = 0.0; // a new contact starts unloaded
+}
+
 // Pairs k0 … k1−1 into the batch, in their order: the touching ones as
 // contacts, those reaching past `hi` (the end of a thread's block) as slot
 // entries; the others are open, and their springs are reset (a new contact
@@ -469,11 +482,27 @@ static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_
 // the end of a row's few pairs. Instead the pairs are walked in fixed pieces
 // across rows (each pair knows its row), and each pair's index is written to
 // both lists, of which only the one it belongs to advances.
+// Below DEM_BRANCH_FREE_MIN_PAIRS listed pairs the loop with the branch is
+// faster: the same few hundred granules' pattern of contacts and near misses
+// comes round every step, and the branch predictor learns it. Measured, the
+// calibration's drum (279 granules, ~850 pairs): the branch-free loop took
+// 0.91-0.94x the speed of the branching one; a bed of 5 000 granules (15 000
+// pairs): 1.12x. Both loops add the same pairs in the same order, so the
+// choice changes no result.
+#define DEM_BRANCH_FREE_MIN_PAIRS 4096
 #define PAIR_PIECE 32
 static DEM_ALWAYS_INLINE void batch_pairs(dem_world *restrict w, const pair_ctx *restrict c, contact_batch *restrict b,
                                           size_t k0, size_t k1, size_t hi, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
+    if (w->nl.count < DEM_BRANCH_FREE_MIN_PAIRS) {
+        for (size_t k = k0; k < k1; ++k) {
+            prefetch_partner(c, k, k1);
+            if (c->nbr[k] >= hi) batch_slot(c, b, c->row[k], k, mask);
+            else batch_pair(w, c, b, c->row[k], k, mask);
+        }
+        return;
+    }
     const uint32_t *restrict row = c->row, *restrict nbr = c->nbr;
     for (size_t p0 = k0; p0 < k1; p0 += PAIR_PIECE) {
         const size_t p1 = p0 + PAIR_PIECE < k1 ? p0 + PAIR_PIECE : k1;
