@@ -101,6 +101,10 @@ void dem_imp_scratch_free(dem_imp_scratch *s)
     memset(s, 0, sizeof *s);
 }
 
+// A loop-level bit above the feature masks: the pair loop for a periodic
+// scene whose centres one wrap may not do for (pair_separation_general).
+#define DEM_GENERAL_IMAGE DEM_FEAT_COUNT_MASKS
+
 // How a pair hands its forces on. DIRECT adds them straight to both granules;
 // SLOTS writes them into the pair's slots, for a pair crossing a thread's
 // block (pair_loop_threaded adds them in the serial order).
@@ -144,27 +148,28 @@ static DEM_ALWAYS_INLINE void add_slot(const pair_ctx *restrict c, size_t i, siz
     c->trq[i] = dem_v3_add(c->trq[i], c->slot_ti[k]);
 }
 
-// Minimum image of one component along a period of length len.
+// Minimum image of one component along a period of length len, for a
+// separation shorter than one and a half periods. Branches, not a select:
+// they are nearly always not taken and predicted so (measured, computing
+// c − len·s with s = 1, −1 or 0 made the step 6 % slower at N = 20 000,
+// 12 interleaved rounds).
 static DEM_ALWAYS_INLINE double wrap_component(double c, double len)
 {
     return c > 0.5 * len ? c - len : c < -0.5 * len ? c + len : c;
 }
 
-// Minimum image along the periodic axis. Centres are wrapped into the domain
-// by every drift, so a separation is shorter than one period and one compare
-// does it; a granule placed outside the domain, before its first drift,
-// takes the general dem_world_min_image. A switch on named components, not a
-// pointer to one, keeps the separation in registers.
-static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(const dem_world *w, dem_vec3 d, int axis, double len)
+// Minimum image along the periodic axis by one wrap: right for every pair
+// while all centres span less than DEM_ONE_WRAP_SPAN periods. A switch on
+// named components, not a pointer to one, keeps the separation in registers.
+static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(dem_vec3 d, int axis, double len)
 {
     dem_vec3 s = d;
-    double c;
     switch (axis) {
-    case 0: c = s.x = wrap_component(d.x, len); break;
-    case 1: c = s.y = wrap_component(d.y, len); break;
-    default: c = s.z = wrap_component(d.z, len); break;
+    case 0: s.x = wrap_component(d.x, len); break;
+    case 1: s.y = wrap_component(d.y, len); break;
+    default: s.z = wrap_component(d.z, len); break;
     }
-    return fabs(c) <= 0.5 * len ? s : dem_world_min_image(w, d);
+    return s;
 }
 
 // One granule's side of a pair: what the contact law reads of it.
@@ -218,12 +223,34 @@ static DEM_ALWAYS_INLINE pair_side side_of(const pair_ctx *restrict c, size_t i)
     return (pair_side){c->vel[i], c->omg[i], c->rad[i], c->inv_mass[i]};
 }
 
+// Separation r_j − r_i of a listed pair while centres may lie more than
+// DEM_ONE_WRAP_SPAN periods apart (a granule placed outside the domain,
+// before its first drift): one wrap where it brings the pair within half a
+// period, the general minimum image where not. Those evaluations have loops
+// of their own (DEM_GENERAL_IMAGE): with this check and its call in the
+// loops of every step, the compiler kept the loops' values on the stack
+// around the call, and every pair paid (measured, the step 1.035x faster
+// at N = 20 000 without it, median of 10 interleaved rounds).
+static dem_vec3 pair_separation_general(const dem_world *w, const pair_ctx *restrict c, size_t i, uint32_t j)
+{
+    const dem_vec3 d = dem_v3_sub(c->pos[j], c->pos[i]), s = wrap_separation(d, c->axis, c->period);
+    return fabs(dem_v3_comp(s, c->axis)) <= 0.5 * c->period ? s : dem_world_min_image(w, d);
+}
+
+// Separation r_j − r_i of a listed pair (minimum image).
+static DEM_ALWAYS_INLINE dem_vec3 pair_separation(const dem_world *w, const pair_ctx *restrict c, size_t i,
+                                                  uint32_t j, const unsigned mask)
+{
+    if (!(mask & DEM_FEAT_PERIODIC)) return dem_v3_sub(c->pos[j], c->pos[i]);
+    if (mask & DEM_GENERAL_IMAGE) return pair_separation_general(w, c, i, j);
+    return wrap_separation(dem_v3_sub(c->pos[j], c->pos[i]), c->axis, c->period);
+}
+
 // Separation r_j − r_i of a listed pair, and whether the granules touch.
-static DEM_ALWAYS_INLINE int pair_touches(dem_world *restrict w, const pair_ctx *restrict c, size_t i, uint32_t j,
+static DEM_ALWAYS_INLINE int pair_touches(const dem_world *w, const pair_ctx *restrict c, size_t i, uint32_t j,
                                           const unsigned mask, dem_vec3 *d)
 {
-    *d = dem_v3_sub(c->pos[j], c->pos[i]);
-    if (mask & DEM_FEAT_PERIODIC) *d = wrap_separation(w, *d, c->axis, c->period);
+    *d = pair_separation(w, c, i, j, mask);
     const double rsum = c->rad[i] + c->rad[j];
     return dem_v3_norm2(*d) < rsum * rsum;
 }
@@ -384,7 +411,7 @@ static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_1
 static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
-    batch_kernels[mask](c, b);
+    batch_kernels[mask & (DEM_FEAT_COUNT_MASKS - 1)](c, b);
     for (int e = 0; e < b->count; ++e) {
         if (b->slot[e]) {
             add_slot(c, b->i[e], b->k[e]);
@@ -742,6 +769,16 @@ DEM_PAIR_LOOP(12)
 DEM_PAIR_LOOP(13)
 DEM_PAIR_LOOP(14)
 DEM_PAIR_LOOP(15)
+#define DEM_GENERAL_IMAGE_LOOP(M) \
+    static void general_image_pair_loop_##M(dem_world *w) { pair_loop(w, DEM_FEAT_PERIODIC | DEM_GENERAL_IMAGE | M); }
+DEM_GENERAL_IMAGE_LOOP(0)
+DEM_GENERAL_IMAGE_LOOP(1)
+DEM_GENERAL_IMAGE_LOOP(2)
+DEM_GENERAL_IMAGE_LOOP(3)
+DEM_GENERAL_IMAGE_LOOP(4)
+DEM_GENERAL_IMAGE_LOOP(5)
+DEM_GENERAL_IMAGE_LOOP(6)
+DEM_GENERAL_IMAGE_LOOP(7)
 
 typedef void (*pair_loop_fn)(dem_world *);
 typedef void (*crossing_pairs_fn)(dem_world *, const uint32_t *, size_t, size_t);
@@ -751,6 +788,7 @@ typedef void (*wall_block_fn)(dem_world *, const dem_wall *, size_t, size_t);
 static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(pair_loop_);
 static const crossing_pairs_fn crossing_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(crossing_pairs_);
 static const block_pairs_fn own_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(own_pairs_);
+static const pair_loop_fn general_image_pair_loops[8] = DEM_BY_MASK_8(general_image_pair_loop_);
 static const wall_loop_fn wall_loops[8] = DEM_BY_MASK_8(wall_loop_);
 static const wall_block_fn wall_blocks[8] = DEM_BY_MASK_8(wall_block_);
 
@@ -789,10 +827,41 @@ void dem_forces_block(dem_world *w, size_t lo, size_t hi)
     for (int k = 0; k < w->n_walls; ++k) wall_blocks[w->walls[k].features & 7u](w, &w->walls[k], lo, hi);
 }
 
+// One wrap gives a pair's minimum image if its separation along the
+// periodic axis is shorter than one and a half periods; centres spanning at
+// most 1.25 periods leave a margin no rounding can take away. A drift wraps
+// every centre into the domain, one period.
+#define DEM_ONE_WRAP_SPAN 1.25
+
+void dem_forces_axis_extent(const dem_world *w, size_t lo, size_t hi, double *lowest, double *highest)
+{
+    const int a = w->def.periodic_axis;
+    double low = INFINITY, high = -INFINITY; // no centre: spans nothing
+    if (a >= 0)
+        for (size_t i = lo; i < hi; ++i) {
+            const double x = dem_v3_comp(w->pos[i], a);
+            low = x < low ? x : low;
+            high = x > high ? x : high;
+        }
+    *lowest = low;
+    *highest = high;
+}
+
+int dem_forces_one_wrap(const dem_world *w, double lowest, double highest)
+{
+    return highest - lowest <= DEM_ONE_WRAP_SPAN * dem_world_period(w);
+}
+
 void dem_forces_compute(dem_world *w)
 {
+    const unsigned mask = w->features & (DEM_FEAT_COUNT_MASKS - 1);
+    double lowest, highest;
+    dem_forces_axis_extent(w, 0, w->n, &lowest, &highest);
     w->imp.on = w->def.implicit_springs && dem_imp_reserve(w) == 0;
-    pair_loops[w->features & (DEM_FEAT_COUNT_MASKS - 1)](w);
+    if ((mask & DEM_FEAT_PERIODIC) && !dem_forces_one_wrap(w, lowest, highest))
+        general_image_pair_loops[mask & (DEM_FEAT_PERIODIC - 1)](w);
+    else
+        pair_loops[mask](w);
     if (w->imp.on) memset(w->imp.wall, 0, 36 * w->n * sizeof *w->imp.wall); // the wall loops add to it
     if (w->def.implicit_damping) gather_damping(w);
     for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & 7u](w, &w->walls[k]);

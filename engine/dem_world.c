@@ -598,8 +598,9 @@ static size_t first_nonfinite(const dem_world *w)
 // it would have left a faulted world half a step further on: not kept.)
 
 // Why the team stopped: its steps done, or after a drift that needs the
-// ordinary path to finish the step (a list rebuild or an escape), or after a
-// kick that left a state not finite.
+// ordinary path to finish the step (a list rebuild, an escape, or centres
+// too far apart for one wrap: see dem_forces_one_wrap), or after a kick that
+// left a state not finite.
 typedef enum { TEAM_DONE, TEAM_AFTER_DRIFT, TEAM_NONFINITE } team_stop;
 
 typedef struct team_result {
@@ -614,8 +615,9 @@ typedef struct team_result {
 typedef struct team_slot {
     size_t escaped, nonfinite;
     double displacement2;
-    size_t crossing_rows; // rows of the block with a pair past its end (set once)
-    char pad[64 - 3 * sizeof(size_t) - sizeof(double)];
+    double lowest, highest; // the block's centres along the periodic axis
+    size_t crossing_rows;   // rows of the block with a pair past its end (set once)
+    char pad[64 - 3 * sizeof(size_t) - 3 * sizeof(double)];
 } team_slot;
 
 static int team_eligible(const dem_world *w)
@@ -638,6 +640,20 @@ static double team_max_displacement2(const team_slot *slot, int nt)
     double m = 0;
     for (int t = 0; t < nt; ++t) m = slot[t].displacement2 > m ? slot[t].displacement2 : m;
     return m;
+}
+
+// Whether the drifted centres are near enough for one wrap along the
+// periodic axis, as the team's force evaluations take them to be. A drift
+// wraps every centre into the domain, so this is a check: should it fail,
+// the team stops and the ordinary step goes on.
+static int team_one_wrap(const dem_world *w, const team_slot *slot, int nt)
+{
+    double lowest = slot[0].lowest, highest = slot[0].highest;
+    for (int t = 1; t < nt; ++t) {
+        lowest = slot[t].lowest < lowest ? slot[t].lowest : lowest;
+        highest = slot[t].highest > highest ? slot[t].highest : highest;
+    }
+    return dem_forces_one_wrap(w, lowest, highest);
 }
 
 // The pairs crossing a block's end, shared out: thread t takes the first
@@ -671,9 +687,11 @@ static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, ui
     while (r.steps < steps) {
         slot[t].escaped = kick_drift_range(w, lo, hi);
         slot[t].displacement2 = dem_nl_max_displacement2_range(w, lo, hi);
+        dem_forces_axis_extent(w, lo, hi, &slot[t].lowest, &slot[t].highest);
 #pragma omp barrier
         r.bad = team_first(slot, nt, 0);
-        if (r.bad != SIZE_MAX || team_max_displacement2(slot, nt) > half_skin * half_skin) {
+        if (r.bad != SIZE_MAX || team_max_displacement2(slot, nt) > half_skin * half_skin ||
+            !team_one_wrap(w, slot, nt)) {
             r.stop = TEAM_AFTER_DRIFT;
             return r;
         }

@@ -176,6 +176,14 @@ int dem_forces_blockwise(const dem_world *w);
 size_t dem_forces_crossing_rows(const dem_world *w, size_t lo, size_t hi, uint32_t *rows);
 void dem_forces_crossing(dem_world *w, const uint32_t *rows, size_t count, size_t end);
 void dem_forces_block(dem_world *w, size_t lo, size_t hi);
+// The lowest and highest centre of granules [lo, hi) along the periodic
+// axis (+inf and −inf for none, or without the axis), and whether centres
+// spanning [lowest, highest] there are near enough for one wrap to give
+// every pair's minimum image.
+// dem_forces_crossing and dem_forces_block take that as given: their caller
+// checks it after each drift (dem_forces_compute checks it itself).
+void dem_forces_axis_extent(const dem_world *w, size_t lo, size_t hi, double *lowest, double *highest);
+int dem_forces_one_wrap(const dem_world *w, double lowest, double highest);
 // Implicit springs: solve (M + Δt C + Δt²/4 K_t) a = F + M g for every
 // granule's rates a (into w->acc); 0 on success, 1 out of memory.
 int dem_implicit_solve(dem_world *w);

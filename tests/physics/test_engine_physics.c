@@ -11,6 +11,8 @@
 //   7. determinism: repeat runs and 1 vs 2 threads are bitwise identical
 //   8. a pair within the skin but apart exerts nothing: free flight, exactly,
 //      under each integration of the dashpots and springs
+//   9. a pair across the periodic boundary pushes as the same pair inside,
+//      also with a granule placed periods away (before its first drift)
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -1070,6 +1072,60 @@ static void test_open_pairs_free_flight(void **state)
     free_flight_run(0, 1, "implicit springs");
 }
 
+// The initial forces (no step taken) of two granules touching with overlap
+// 0.1 R along the periodic axis z (period 0.02 m), granule 0 at z0 and
+// granule 1 at z1.
+static dem_vec3 periodic_pair_force(double z0, double z1, double *force_on_1)
+{
+    const double R = 5e-4;
+    dem_world_def def = dem_default_world_def();
+    def.gravity = dem_v3(0, 0, 0);
+    def.periodic_axis = 2;
+    def.domain_lo = dem_v3(-0.01, -0.01, -0.01), def.domain_hi = dem_v3(0.01, 0.01, 0.01);
+    dem_world *w = world_new(&def);
+    const int64_t id0 = dem_world_add_granule(w, dem_v3(0, 0, z0), dem_v3(0, 0, 0), dem_v3(0, 0, 0), R, RHO);
+    add_ok(w, dem_v3(0, 0, z1), dem_v3(0, 0, 0), dem_v3(0, 0, 0), R, RHO);
+    assert_true(id0 >= 0);
+    step_ok(w, 0);
+    const dem_granules_view g = dem_world_granules(w);
+    const size_t first = g.id[0] == (uint64_t)id0 ? 0 : 1; // the engine may have re-sorted them
+    const dem_vec3 f = g.force[first];
+    *force_on_1 = g.force[1 - first].z;
+    dem_world_destroy(w);
+    return f;
+}
+
+// A pair across the boundary of the periodic axis is the same pair as one
+// inside (minimum image), and the normal force of eq. 3 on each is k_n h.
+// The pair loops take the minimum image by one wrap while all centres lie
+// within 1.25 periods; a granule placed further out, before its first
+// drift, goes through the general minimum image: placed three periods over,
+// one wrap would leave the pair a period apart, and it would not push.
+static void test_periodic_pair_across_boundary(void **state)
+{
+    (void)state;
+    const double R = 5e-4, h = 0.1 * R, a = R - 0.5 * h, L = 0.02;
+    const double k_n = dem_default_world_def().granule.k_n;
+    const struct {
+        double z0, z1;
+        const char *label;
+    } cases[] = {
+        {-a, a, "inside"},
+        {0.01 - a, -0.01 + a, "across the boundary"},
+        {0.01 - a, -0.01 + a + 3 * L, "granule 1 three periods over"},
+        {0.01 - a - 2 * L, -0.01 + a, "granule 0 two periods under"},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
+        double f1;
+        const dem_vec3 f0 = periodic_pair_force(cases[c].z0, cases[c].z1, &f1);
+        printf("  %s: force on 0 (%.3g, %.3g, %.10g) N, on 1 %.10g N; k_n h = %.10g N\n", cases[c].label, f0.x,
+               f0.y, f0.z, f1, k_n * h);
+        assert_true(f0.x == 0.0 && f0.y == 0.0);
+        assert_rel(-f0.z, k_n * h, 1e-9, cases[c].label); // granule 1 is above granule 0 (minimum image)
+        assert_rel(f1, k_n * h, 1e-9, cases[c].label);
+    }
+}
+
 static struct timespec t_start;
 static int timer_start(void **state)
 {
@@ -1104,6 +1160,7 @@ int main(void)
         TEST(test_momentum_conserved),
         TEST(test_determinism),
         TEST(test_open_pairs_free_flight),
+        TEST(test_periodic_pair_across_boundary),
     };
     int failed = cmocka_run_group_tests_name("default integration", tests, NULL, NULL);
     // Determinism, momentum and free flight run their own integrations;
@@ -1115,7 +1172,7 @@ int main(void)
         TEST(test_incline_rolling_resistance), TEST(test_launch_slip_roll),
         TEST(test_launch_slip_roll_stop),     TEST(test_objectivity_rotation_about_normal),
         TEST(test_objectivity_rotation_normal_to_n), TEST(test_lever_radius_drift),
-        TEST(test_set_velocity_keeps_history),
+        TEST(test_set_velocity_keeps_history),  TEST(test_periodic_pair_across_boundary),
     };
     return failed + cmocka_run_group_tests_name("implicit springs forced", forced, NULL, NULL);
 }
