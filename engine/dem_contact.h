@@ -72,13 +72,13 @@ typedef struct dem_contact_coeffs {
 
 /// Geometry and kinematics of one contact at the current step.
 typedef struct dem_contact_state {
-    dem_vec3 normal;       ///< n_ij, unit, pointing from i to j
-    double overlap;        ///< h_ij = R_i + R_j − |r_j − r_i| > 0
-    dem_vec3 vrel;         ///< velocity of i's contact point minus j's (eq. 5, 7)
-    dem_vec3 wrel;         ///< ω_i − ω_j (eq. 12); for a wall ω_j is the wall's spin
-    double twist;          ///< angle the pair turned about n this step, ½(ω_i+ω_j)·n Δt
-    double reduced_mass;   ///< m* (m_i for a wall)
-    double reduced_radius; ///< R* (R_i for a wall)
+    dem_vec3 normal;          ///< n_ij, unit, pointing from i to j
+    double overlap;           ///< h_ij = R_i + R_j − |r_j − r_i| > 0
+    dem_vec3 vrel;            ///< velocity of i's contact point minus j's (eq. 5, 7)
+    dem_vec3 wrel;            ///< ω_i − ω_j (eq. 12); for a wall ω_j is the wall's spin
+    double twist;             ///< angle the pair turned about n this step, ½(ω_i+ω_j)·n Δt
+    double root_reduced_mass; ///< sqrt(m*), of eq. 4 (m* = m_i for a wall)
+    double reduced_radius;    ///< R* (R_i for a wall)
     double dt;
 } dem_contact_state;
 
@@ -183,7 +183,7 @@ static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, cons
     if (features & DEM_FEAT_DAMPING) {
         // Eq. 4: γ_n = 2ξ sqrt(m* k_n), on for the phase(s) the reading selects.
         double on = vn > 0.0 ? c->damp_approaching : c->damp_separating;
-        double gamma = on * c->two_xi_sqrt_kn * sqrt(s->reduced_mass);
+        double gamma = on * c->two_xi_sqrt_kn * s->root_reduced_mass;
         fn += gamma * vn;
         int clamped = c->clamp_tension != 0.0 && fn < 0.0;
         fn = clamped ? 0.0 : fn;

@@ -117,7 +117,8 @@ enum { DEM_SLOTS = 0, DEM_DIRECT = 1 };
 // store; a local copy stays in registers.
 typedef struct pair_ctx {
     const dem_vec3 *pos, *vel, *omg;
-    const double *rad, *inv_mass;
+    const double *rad;
+    const dem_pair_constants *constants;
     dem_vec3 *frc, *trq;
     const uint32_t *nbr, *row; // partner and row (granule i) of each pair
     double *hist;
@@ -132,7 +133,7 @@ typedef struct pair_ctx {
 
 static inline pair_ctx pair_ctx_make(const dem_world *w)
 {
-    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->inv_mass, w->frc, w->trq, w->nl.j, w->nl.row, w->nl.hist,
+    return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->nl.constants, w->frc, w->trq, w->nl.j, w->nl.row, w->nl.hist,
                       w->pair_f, w->pair_ti, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
                       w->def.periodic_axis, w->def.implicit_damping, w->imp.on};
 }
@@ -175,7 +176,7 @@ static DEM_ALWAYS_INLINE dem_vec3 wrap_separation(dem_vec3 d, int axis, double l
 // One granule's side of a pair: what the contact law reads of it.
 typedef struct pair_side {
     dem_vec3 vel, omg;
-    double rad, inv_mass;
+    double rad;
 } pair_side;
 
 // What a touching pair does: force on i (j gets −force), torques on i and j,
@@ -187,10 +188,11 @@ typedef struct pair_result {
 
 // The contact of a touching pair with separation d = r_j − r_i (minimum
 // image): geometry, eq. 5 and 7 kinematics, the law (dem_contact_eval) and
-// the torques of eq. 9–10. Shared by the scalar path and the batch loop, so
-// both are the same arithmetic, bit for bit.
+// the torques of eq. 9–10; pk: the pair's constants. Shared by the scalar
+// path and the batch loop, so both are the same arithmetic, bit for bit.
 static DEM_ALWAYS_INLINE pair_result pair_contact(const pair_ctx *restrict c, dem_vec3 d, const pair_side *si,
-                                                  const pair_side *sj, double *restrict hist, const unsigned mask)
+                                                  const pair_side *sj, const dem_pair_constants *pk,
+                                                  double *restrict hist, const unsigned mask)
 {
     const double ri = si->rad, rj = sj->rad, rsum = ri + rj;
     const double dist = sqrt(dem_v3_norm2(d));
@@ -206,8 +208,8 @@ static DEM_ALWAYS_INLINE pair_result pair_contact(const pair_ctx *restrict c, de
                         dem_v3_sub(sj->vel, dem_v3_cross(dem_v3_scale(wj, aj), n)));
     s.wrel = dem_v3_sub(wi, wj);
     s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
-    s.reduced_mass = 1.0 / (si->inv_mass + sj->inv_mass);
-    s.reduced_radius = ri * rj / rsum;
+    s.root_reduced_mass = pk->root_reduced_mass;
+    s.reduced_radius = pk->reduced_radius;
     s.dt = c->hist_dt;
     dem_contact_out out;
     dem_contact_eval(&c->gg, &s, hist, &out, mask);
@@ -220,7 +222,7 @@ static DEM_ALWAYS_INLINE pair_result pair_contact(const pair_ctx *restrict c, de
 
 static DEM_ALWAYS_INLINE pair_side side_of(const pair_ctx *restrict c, size_t i)
 {
-    return (pair_side){c->vel[i], c->omg[i], c->rad[i], c->inv_mass[i]};
+    return (pair_side){c->vel[i], c->omg[i], c->rad[i]};
 }
 
 // Separation r_j − r_i of a listed pair while centres may lie more than
@@ -283,7 +285,7 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *
         return;
     }
     const pair_side si = side_of(c, i), sj = side_of(c, j);
-    const pair_result r = pair_contact(c, d, &si, &sj, hist, mask);
+    const pair_result r = pair_contact(c, d, &si, &sj, &c->constants[k], hist, mask);
     if (c->implicit_damping) { // read only by gather_damping
         w->pair_g[k] = r.damping_coeff;
         w->pair_n[k] = r.normal;
@@ -320,7 +322,7 @@ typedef struct contact_batch {
     // in the order. Its lane of the law runs on neutral data and is dropped.
     unsigned char slot[DEM_BATCH];
     double d[3][DEM_BATCH];
-    double rad[2][DEM_BATCH], inv_mass[2][DEM_BATCH];
+    double rad[2][DEM_BATCH], root_reduced_mass[DEM_BATCH], reduced_radius[DEM_BATCH];
     double vel[6][DEM_BATCH], omg[6][DEM_BATCH]; // x y z of i, then of j
     double hist[6][DEM_BATCH];
     double f[3][DEM_BATCH], ti[3][DEM_BATCH], tj[3][DEM_BATCH];
@@ -329,7 +331,6 @@ typedef struct contact_batch {
 static DEM_ALWAYS_INLINE void batch_put_side(contact_batch *restrict b, int e, int side, const pair_side *s)
 {
     b->rad[side][e] = s->rad;
-    b->inv_mass[side][e] = s->inv_mass;
     const double v[3] = {s->vel.x, s->vel.y, s->vel.z}, o[3] = {s->omg.x, s->omg.y, s->omg.z};
     for (int q = 0; q < 3; ++q) b->vel[3 * side + q][e] = v[q], b->omg[3 * side + q][e] = o[q];
 }
@@ -338,8 +339,7 @@ static DEM_ALWAYS_INLINE pair_side batch_side(const contact_batch *restrict b, i
 {
     const int o = 3 * side;
     return (pair_side){dem_v3(b->vel[o][e], b->vel[o + 1][e], b->vel[o + 2][e]),
-                       dem_v3(b->omg[o][e], b->omg[o + 1][e], b->omg[o + 2][e]), b->rad[side][e],
-                       b->inv_mass[side][e]};
+                       dem_v3(b->omg[o][e], b->omg[o + 1][e], b->omg[o + 2][e]), b->rad[side][e]};
 }
 
 // No dependence between the iterations of the loop that follows: GCC needs
@@ -361,7 +361,8 @@ static DEM_ALWAYS_INLINE void batch_compute(const pair_ctx *restrict c, contact_
         const pair_side si = batch_side(b, e, 0), sj = batch_side(b, e, 1);
         double h[6] = {0, 0, 0, 0, 0, 0};
         for (int q = 0; q < hl; ++q) h[q] = b->hist[q][e];
-        const pair_result r = pair_contact(c, dem_v3(b->d[0][e], b->d[1][e], b->d[2][e]), &si, &sj, h, mask);
+        const dem_pair_constants pk = {b->root_reduced_mass[e], b->reduced_radius[e]};
+        const pair_result r = pair_contact(c, dem_v3(b->d[0][e], b->d[1][e], b->d[2][e]), &si, &sj, &pk, h, mask);
         for (int q = 0; q < hl; ++q) b->hist[q][e] = h[q];
         b->f[0][e] = r.force.x, b->f[1][e] = r.force.y, b->f[2][e] = r.force.z;
         b->ti[0][e] = r.torque_i.x, b->ti[1][e] = r.torque_i.y, b->ti[2][e] = r.torque_i.z;
@@ -434,7 +435,8 @@ static DEM_ALWAYS_INLINE void batch_slot(const pair_ctx *restrict c, contact_bat
     const int e = b->count++;
     b->slot[e] = 1;
     b->i[e] = b->j[e] = (uint32_t)i, b->k[e] = k;
-    const pair_side neutral = {{0, 0, 0}, {0, 0, 0}, 1.0, 1.0}; // any finite contact will do
+    const pair_side neutral = {{0, 0, 0}, {0, 0, 0}, 1.0}; // any finite contact will do
+    b->root_reduced_mass[e] = b->reduced_radius[e] = 1.0;
     b->d[0][e] = 1.0, b->d[1][e] = b->d[2][e] = 0.0;
     batch_put_side(b, e, 0, &neutral);
     batch_put_side(b, e, 1, &neutral);
@@ -447,7 +449,7 @@ static DEM_ALWAYS_INLINE void batch_slot(const pair_ctx *restrict c, contact_bat
 // granules stream in sequence and the hardware prefetcher has them; a
 // partner j > i lies ahead of that stream, often far ahead (a granule's
 // neighbours in the next layer are a layer's worth of granules further on in
-// Morton order), and its seven lines (pos, vel, omg, rad, inv_mass, frc, trq)
+// Morton order), and its six lines (pos, vel, omg, rad, frc, trq)
 // came in one demand miss after another, each stalling the pair's chain of
 // loads. Into L2 (locality 2), not L1: 96 pairs' partners would crowd L1 out.
 // Read intent also for frc and trq: a line no other core holds comes in
@@ -466,7 +468,6 @@ static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_
     __builtin_prefetch(c->vel + j, 0, 2);
     __builtin_prefetch(c->omg + j, 0, 2);
     __builtin_prefetch(c->rad + j, 0, 2);
-    __builtin_prefetch(c->inv_mass + j, 0, 2);
     __builtin_prefetch(c->frc + j, 0, 2);
     __builtin_prefetch(c->trq + j, 0, 2);
 }
@@ -481,6 +482,8 @@ static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_
     b->slot[e] = 0;
     b->i[e] = (uint32_t)i, b->j[e] = j, b->k[e] = k;
     b->d[0][e] = d.x, b->d[1][e] = d.y, b->d[2][e] = d.z;
+    b->root_reduced_mass[e] = c->constants[k].root_reduced_mass;
+    b->reduced_radius[e] = c->constants[k].reduced_radius;
     const pair_side si = side_of(c, i), sj = side_of(c, j);
     batch_put_side(b, e, 0, &si);
     batch_put_side(b, e, 1, &sj);
@@ -700,7 +703,7 @@ static DEM_ALWAYS_INLINE void wall_force(dem_world *restrict w, const dem_wall *
     s.vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)), v_wall);
     s.wrel = dem_v3_sub(wi, spin);
     s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, spin), n) * w->hist_dt;
-    s.reduced_mass = w->mass[i]; // infinite wall mass: m* = m_i
+    s.root_reduced_mass = sqrt(w->mass[i]); // infinite wall mass: m* = m_i
     s.reduced_radius = r;        // infinite wall radius: R* = R_i
     s.dt = w->hist_dt;
     dem_contact_out out;

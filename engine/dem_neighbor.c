@@ -137,6 +137,15 @@ static size_t scan_row(const dem_world *w, const cell_grid *g, size_t i, uint32_
     return count;
 }
 
+// The constants of pair (i, j), in the arithmetic the contact law had
+// (m* = 1 / (1/m_i + 1/m_j), R* = R_i R_j / (R_i + R_j)): symmetric in i and j
+// bit for bit, so a pair's roles may swap.
+static dem_pair_constants pair_constants(const dem_world *w, size_t i, size_t j)
+{
+    const double ri = w->rad[i], rj = w->rad[j];
+    return (dem_pair_constants){sqrt(1.0 / (w->inv_mass[i] + w->inv_mass[j])), ri * rj / (ri + rj)};
+}
+
 static void sort_row(uint32_t *a, size_t n)
 {
     for (size_t i = 1; i < n; ++i) { // rows are short: insertion sort
@@ -196,7 +205,9 @@ static int ensure_pairs(dem_world *w, size_t pairs)
         if (j) nl->j = j;
         uint32_t *row = j ? realloc(nl->row, cap * sizeof *row) : NULL;
         if (row) nl->row = row;
-        double *h = row ? realloc(nl->hist, cap * hl * sizeof *h) : NULL;
+        dem_pair_constants *pc = row ? realloc(nl->constants, cap * sizeof *pc) : NULL;
+        if (pc) nl->constants = pc;
+        double *h = pc ? realloc(nl->hist, cap * hl * sizeof *h) : NULL;
         if (h) nl->hist = h;
         if (!h) return 1;
         nl->cap = cap;
@@ -309,7 +320,10 @@ int dem_nl_rebuild(dem_world *w)
         for (size_t i = 0; i < n; ++i) {
             scan_row(w, &g, i, nl->j + start[i]);
             sort_row(nl->j + start[i], start[i + 1] - start[i]);
-            for (size_t k = start[i]; k < start[i + 1]; ++k) nl->row[k] = (uint32_t)i;
+            for (size_t k = start[i]; k < start[i + 1]; ++k) {
+                nl->row[k] = (uint32_t)i;
+                nl->constants[k] = pair_constants(w, i, nl->j[k]);
+            }
             carry_history(nl, &w->nl_old, old_rows, i);
         }
         fail = build_reverse(w);
@@ -350,6 +364,7 @@ void dem_nl_free(dem_neighbor_list *nl)
     free(nl->start);
     free(nl->j);
     free(nl->row);
+    free(nl->constants);
     free(nl->hist);
     memset(nl, 0, sizeof *nl);
 }

@@ -118,6 +118,7 @@ static void clone_list(dem_neighbor_list *dst, const dem_neighbor_list *src, int
     dst->start = dup_bytes(src->start, src->start ? (src->rows + 1) * sizeof *src->start : 0, fail);
     dst->j = dup_bytes(src->j, src->cap * sizeof *src->j, fail);
     dst->row = dup_bytes(src->row, src->cap * sizeof *src->row, fail);
+    dst->constants = dup_bytes(src->constants, src->cap * sizeof *src->constants, fail);
     dst->hist = dup_bytes(src->hist, src->hist_cap * sizeof *src->hist, fail);
 }
 

@@ -52,6 +52,8 @@ static dem_contact_params base_params(void)
                                 .damping = DEM_DAMPING_APPROACHING};
 }
 
+#define M_STAR 0.25 // reduced mass of base_state, kg
+
 static dem_contact_state base_state(void)
 {
     dem_contact_state s;
@@ -61,7 +63,7 @@ static dem_contact_state base_state(void)
     s.vrel = dem_v3(0, 0, 0);
     s.wrel = dem_v3(0, 0, 0);
     s.twist = 0.0;
-    s.reduced_mass = 0.25;
+    s.root_reduced_mass = 0.5; // m* = 0.25 (M_STAR)
     s.reduced_radius = 0.5;
     s.dt = 1e-3;
     return s;
@@ -114,7 +116,7 @@ static void test_damping_readings(void **state)
     (void)state;
     const dem_contact_params p = base_params();
     const dem_contact_state s = base_state();
-    const double gamma = 2.0 * p.xi * sqrt(s.reduced_mass * p.k_n); // eq. 4
+    const double gamma = 2.0 * p.xi * sqrt(M_STAR * p.k_n); // eq. 4
     const double spring = p.k_n * s.overlap;
     const double v_in = 0.02, v_out = -0.02; // |γ v| < k h: the force stays repulsive
     const double v_pull = -2.0;              // γ|v| > k h: an undamped-at-zero dashpot would pull
@@ -201,7 +203,7 @@ static void check_truncation(dem_damping_mode mode, double vn)
     dem_contact_eval(&c, &s, hist, &out, mask);
 
     // Independent normal force: k h + γ v_n if the reading damps this phase.
-    double gamma = 2.0 * p.xi * sqrt(s.reduced_mass * p.k_n);
+    double gamma = 2.0 * p.xi * sqrt(M_STAR * p.k_n);
     int damped = mode == DEM_DAMPING_ALWAYS || mode == DEM_DAMPING_NO_TENSION ||
                  (mode == DEM_DAMPING_APPROACHING && vn > 0) || (mode == DEM_DAMPING_SEPARATING && vn < 0);
     double fn = p.k_n * s.overlap + (damped ? gamma * vn : 0.0);
