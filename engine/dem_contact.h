@@ -144,16 +144,33 @@ static DEM_ALWAYS_INLINE dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, 
     return dem_v3_scale(proj, plen2 > 0.0 ? ratio : 0.0);
 }
 
-/// Advance one history spring by its relative velocity and apply the Coulomb
-/// limit: F = −k·δ, |F| ≤ μ|F_n|; on truncation the spring is reset so that
-/// k|δ| equals the limit (eq. 6+8 for sliding, eq. 11+13 for rolling).
-/// `*sticking` becomes 1 if the spring stayed below the limit.
-static DEM_ALWAYS_INLINE dem_vec3 dem_spring_update(double *hist, dem_vec3 n, double twist, dem_vec3 vel, double dt,
-                                         double k, double inv_k, double limit, int *sticking)
+/// The law in stages, each a function of the last one's results, so that a
+/// batch of contacts can run each stage over the whole batch in turn
+/// (dem_forces.c): a stage's chain of dependent square roots and divisions
+/// is then short, and the processor overlaps it across contacts, where the
+/// whole law in one loop left it waiting on each chain in turn.
+/// dem_contact_eval runs the same stages one after the other: one
+/// arithmetic, bit for bit, for every caller.
+
+/// Advance one history spring: carried onto the current tangent plane, then
+/// moved by its relative velocity over dt (eq. 6 for sliding, eq. 11 for
+/// rolling); returns it, and its elastic force F = −k·δ in `force`.
+static DEM_ALWAYS_INLINE dem_vec3 dem_spring_advance(const double *hist, dem_vec3 n, double twist, dem_vec3 vel,
+                                                     double dt, double k, dem_vec3 *force)
 {
     dem_vec3 spring = dem_spring_carry(dem_v3(hist[0], hist[1], hist[2]), n, twist);
     spring = dem_v3_axpy(dt, vel, spring);
-    dem_vec3 force = dem_v3_scale(spring, -k);
+    *force = dem_v3_scale(spring, -k);
+    return spring;
+}
+
+/// The Coulomb limit on an advanced spring and its force: |F| ≤ μ|F_n|; on
+/// truncation the spring is reset so that k|δ| equals the limit (eq. 8 for
+/// sliding, eq. 13 for rolling). Stores the spring in `hist`, returns the
+/// force; `*sticking` becomes 1 if the spring stayed below the limit.
+static DEM_ALWAYS_INLINE dem_vec3 dem_spring_limit(double *hist, dem_vec3 spring, dem_vec3 force, double inv_k,
+                                                   double limit, int *sticking)
+{
     // Branch-free as dem_spring_carry: both outcomes computed, one kept.
     double f2 = dem_v3_norm2(force);
     const int slides = f2 > limit * limit;
@@ -168,12 +185,18 @@ static DEM_ALWAYS_INLINE dem_vec3 dem_spring_update(double *hist, dem_vec3 n, do
     return force;
 }
 
-/// The LSD contact law, eq. 3–8 and 11–13. `features` must be a constant at
-/// the call site. `hist` holds dem_history_len(features) doubles: tangential
-/// spring δ_s first (if on), then rolling spring δ_r (if on); zero for a new
-/// contact. Springs store displacements; forces are −k·δ.
-static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, const dem_contact_state *s, double *hist,
-                                    dem_contact_out *out, const unsigned features)
+/// What drives the springs, from the normal stage.
+typedef struct dem_contact_drive {
+    double fn_abs; ///< |F_n|, to which the Coulomb limits are proportional
+    dem_vec3 vt;   ///< tangential part of the contact-point velocity (eq. 7)
+    dem_vec3 vr;   ///< rolling velocity −R* (ω_i − ω_j) × n (eq. 12)
+} dem_contact_drive;
+
+/// First stage of the law: the normal force of eq. 3–4 into out->force,
+/// out->normal_force and out->damping_coeff; the springs' drive.
+static DEM_ALWAYS_INLINE dem_contact_drive dem_contact_normal(const dem_contact_coeffs *c,
+                                                              const dem_contact_state *s, dem_contact_out *out,
+                                                              const unsigned features)
 {
     const dem_vec3 n = s->normal;
     const double vn = dem_v3_dot(s->vrel, n); // > 0 approaching (eq. 5)
@@ -191,28 +214,41 @@ static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, cons
     }
     out->normal_force = fn;
     out->force = dem_v3_scale(n, -fn);
-    const double fn_abs = fabs(fn);
-    int slot = 0, stick = 0;
+    dem_contact_drive drive = {fabs(fn), dem_v3(0, 0, 0), dem_v3(0, 0, 0)};
+    // Eq. 7: tangential part of the contact-point relative velocity.
+    if (features & DEM_FEAT_TANGENTIAL) drive.vt = dem_v3_axpy(-vn, n, s->vrel);
+    // Eq. 12: v_rel,r = −R* (ω_i − ω_j) × n.
+    if (features & DEM_FEAT_ROLLING) drive.vr = dem_v3_scale(dem_v3_cross(s->wrel, n), -s->reduced_radius);
+    return drive;
+}
+
+/// Slot in the history of the rolling spring: after the tangential one.
+static inline int dem_rolling_slot(unsigned features) { return (features & DEM_FEAT_TANGENTIAL) ? 3 : 0; }
+
+/// The LSD contact law, eq. 3–8 and 11–13. `features` must be a constant at
+/// the call site. `hist` holds dem_history_len(features) doubles: tangential
+/// spring δ_s first (if on), then rolling spring δ_r (if on); zero for a new
+/// contact. Springs store displacements; forces are −k·δ.
+static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, const dem_contact_state *s, double *hist,
+                                    dem_contact_out *out, const unsigned features)
+{
+    const dem_contact_drive drive = dem_contact_normal(c, s, out, features);
+    int stick = 0;
     out->k_tangential = out->k_rolling = 0.0;
+    out->f_tangential = out->f_rolling = dem_v3(0, 0, 0);
     if (features & DEM_FEAT_TANGENTIAL) {
-        // Eq. 7: tangential part of the contact-point relative velocity.
-        dem_vec3 vt = dem_v3_axpy(-vn, n, s->vrel);
-        out->f_tangential =
-            dem_spring_update(hist, n, s->twist, vt, s->dt, c->k_s, c->inv_k_s, c->mu_s * fn_abs, &stick);
+        dem_vec3 f;
+        const dem_vec3 spring = dem_spring_advance(hist, s->normal, s->twist, drive.vt, s->dt, c->k_s, &f);
+        out->f_tangential = dem_spring_limit(hist, spring, f, c->inv_k_s, c->mu_s * drive.fn_abs, &stick);
         out->k_tangential = stick ? c->k_s : 0.0;
         out->force = dem_v3_add(out->force, out->f_tangential);
-        slot += 3;
-    } else {
-        out->f_tangential = dem_v3(0, 0, 0);
     }
     if (features & DEM_FEAT_ROLLING) {
-        // Eq. 12: v_rel,r = −R* (ω_i − ω_j) × n.
-        dem_vec3 vr = dem_v3_scale(dem_v3_cross(s->wrel, n), -s->reduced_radius);
-        out->f_rolling =
-            dem_spring_update(hist + slot, n, s->twist, vr, s->dt, c->k_r, c->inv_k_r, c->mu_r * fn_abs, &stick);
+        double *h = hist + dem_rolling_slot(features);
+        dem_vec3 f;
+        const dem_vec3 spring = dem_spring_advance(h, s->normal, s->twist, drive.vr, s->dt, c->k_r, &f);
+        out->f_rolling = dem_spring_limit(h, spring, f, c->inv_k_r, c->mu_r * drive.fn_abs, &stick);
         out->k_rolling = stick ? c->k_r : 0.0;
-    } else {
-        out->f_rolling = dem_v3(0, 0, 0);
     }
 }
 

@@ -186,38 +186,62 @@ typedef struct pair_result {
     double damping_coeff, k_tangential, k_rolling, lever_i, lever_j, reduced_radius;
 } pair_result;
 
-// The contact of a touching pair with separation d = r_j − r_i (minimum
-// image): geometry, eq. 5 and 7 kinematics, the law (dem_contact_eval) and
-// the torques of eq. 9–10; pk: the pair's constants. Shared by the scalar
-// path and the batch loop, so both are the same arithmetic, bit for bit.
+// Geometry and kinematics of a touching pair with separation d = r_j − r_i
+// (minimum image), and its lever arms.
+typedef struct pair_geometry {
+    dem_contact_state s;
+    double lever_i, lever_j;
+} pair_geometry;
+
+static DEM_ALWAYS_INLINE pair_geometry pair_geometry_of(const pair_ctx *restrict c, dem_vec3 d, const pair_side *si,
+                                                        const pair_side *sj, const dem_pair_constants *pk)
+{
+    const double ri = si->rad, rj = sj->rad, rsum = ri + rj;
+    const double dist = sqrt(dem_v3_norm2(d));
+    pair_geometry g;
+    g.s.normal = safe_normal(d, dist);
+    g.s.overlap = rsum - dist;
+    // Lever arms: centre to contact point (or R, see dem_lever_arm).
+    g.lever_i = ri - c->half_lever * g.s.overlap;
+    g.lever_j = rj - c->half_lever * g.s.overlap;
+    const dem_vec3 n = g.s.normal, wi = si->omg, wj = sj->omg;
+    // Eq. 5 and 7: velocity of i's contact point relative to j's.
+    g.s.vrel = dem_v3_sub(dem_v3_add(si->vel, dem_v3_cross(dem_v3_scale(wi, g.lever_i), n)),
+                          dem_v3_sub(sj->vel, dem_v3_cross(dem_v3_scale(wj, g.lever_j), n)));
+    g.s.wrel = dem_v3_sub(wi, wj);
+    g.s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
+    g.s.root_reduced_mass = pk->root_reduced_mass;
+    g.s.reduced_radius = pk->reduced_radius;
+    g.s.dt = c->hist_dt;
+    return g;
+}
+
+// Eq. 9–10: the torques on i and on j of a contact's tangential force f_t
+// and rolling quasi-force f_r.
+static DEM_ALWAYS_INLINE void pair_torques(dem_vec3 n, dem_vec3 f_t, dem_vec3 f_r, double reduced_radius,
+                                           double lever_i, double lever_j, dem_vec3 *ti, dem_vec3 *tj)
+{
+    const dem_vec3 ts = dem_v3_cross(n, f_t);
+    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, f_r), reduced_radius);
+    *ti = dem_v3_sub(dem_v3_scale(ts, lever_i), tr);
+    *tj = dem_v3_add(dem_v3_scale(ts, lever_j), tr);
+}
+
+// The contact of a touching pair, one pair at a time: geometry, the law
+// (dem_contact_eval) and the torques. The batch runs the same functions in
+// stages (batch_compute): the same arithmetic, bit for bit.
 static DEM_ALWAYS_INLINE pair_result pair_contact(const pair_ctx *restrict c, dem_vec3 d, const pair_side *si,
                                                   const pair_side *sj, const dem_pair_constants *pk,
                                                   double *restrict hist, const unsigned mask)
 {
-    const double ri = si->rad, rj = sj->rad, rsum = ri + rj;
-    const double dist = sqrt(dem_v3_norm2(d));
-    dem_contact_state s;
-    s.normal = safe_normal(d, dist);
-    s.overlap = rsum - dist;
-    // Lever arms: centre to contact point (or R, see dem_lever_arm).
-    const double ai = ri - c->half_lever * s.overlap;
-    const double aj = rj - c->half_lever * s.overlap;
-    const dem_vec3 n = s.normal, wi = si->omg, wj = sj->omg;
-    // Eq. 5 and 7: velocity of i's contact point relative to j's.
-    s.vrel = dem_v3_sub(dem_v3_add(si->vel, dem_v3_cross(dem_v3_scale(wi, ai), n)),
-                        dem_v3_sub(sj->vel, dem_v3_cross(dem_v3_scale(wj, aj), n)));
-    s.wrel = dem_v3_sub(wi, wj);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, wj), n) * c->hist_dt;
-    s.root_reduced_mass = pk->root_reduced_mass;
-    s.reduced_radius = pk->reduced_radius;
-    s.dt = c->hist_dt;
+    const pair_geometry g = pair_geometry_of(c, d, si, sj, pk);
     dem_contact_out out;
-    dem_contact_eval(&c->gg, &s, hist, &out, mask);
-    // Eq. 9–10: torques on i and on j.
-    const dem_vec3 ts = dem_v3_cross(n, out.f_tangential);
-    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), s.reduced_radius);
-    return (pair_result){out.force, dem_v3_sub(dem_v3_scale(ts, ai), tr), dem_v3_add(dem_v3_scale(ts, aj), tr), n,
-                         out.damping_coeff, out.k_tangential, out.k_rolling, ai, aj, s.reduced_radius};
+    dem_contact_eval(&c->gg, &g.s, hist, &out, mask);
+    pair_result r = {out.force, {0, 0, 0}, {0, 0, 0}, g.s.normal, out.damping_coeff, out.k_tangential,
+                     out.k_rolling, g.lever_i, g.lever_j, g.s.reduced_radius};
+    pair_torques(g.s.normal, out.f_tangential, out.f_rolling, g.s.reduced_radius, g.lever_i, g.lever_j, &r.torque_i,
+                 &r.torque_j);
+    return r;
 }
 
 static DEM_ALWAYS_INLINE pair_side side_of(const pair_ctx *restrict c, size_t i)
@@ -306,11 +330,11 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *
 //
 // The explicit integration's pairs go through a batch: the touching pairs of
 // a stretch of rows are gathered into structure-of-arrays form, the contact
-// law runs over the batch in a loop the compiler vectorises (pair_contact is
-// branch-free; -fno-trapping-math lets it evaluate both sides of a select),
-// and the results are added to the granules in the pairs' own order — the
-// serial order, so the sums and the final state are bitwise those of the
-// one-pair-at-a-time loop.
+// law runs over the batch in stages, each a loop the compiler vectorises
+// (the law is branch-free; -fno-trapping-math lets it evaluate both sides of
+// a select), and the results are added to the granules in the pairs' own
+// order — the serial order, so the sums and the final state are bitwise
+// those of the one-pair-at-a-time loop.
 #define DEM_BATCH 32
 
 typedef struct contact_batch {
@@ -326,6 +350,12 @@ typedef struct contact_batch {
     double vel[6][DEM_BATCH], omg[6][DEM_BATCH]; // x y z of i, then of j
     double hist[6][DEM_BATCH];
     double f[3][DEM_BATCH], ti[3][DEM_BATCH], tj[3][DEM_BATCH];
+    // Between the stages of batch_compute: geometry, the springs' drive, and
+    // the advanced springs (tangential x y z, then rolling) and their forces.
+    double n[3][DEM_BATCH], overlap[DEM_BATCH], vrel[3][DEM_BATCH], wrel[3][DEM_BATCH], twist[DEM_BATCH];
+    double lever[2][DEM_BATCH];
+    double fn_abs[DEM_BATCH], vt[3][DEM_BATCH], vr[3][DEM_BATCH];
+    double spring[6][DEM_BATCH], spring_force[6][DEM_BATCH];
 } contact_batch;
 
 static DEM_ALWAYS_INLINE void batch_put_side(contact_batch *restrict b, int e, int side, const pair_side *s)
@@ -351,23 +381,117 @@ static DEM_ALWAYS_INLINE pair_side batch_side(const contact_batch *restrict b, i
 #define DEM_INDEPENDENT_ITERATIONS
 #endif
 
-// The law over the whole batch: one iteration per contact, no branches, no
-// dependence between iterations.
+// The vector in rows a[0], a[1], a[2] of the batch, lane e, and its store.
+#define BATCH_V3(a, e) dem_v3((a)[0][e], (a)[1][e], (a)[2][e])
+static DEM_ALWAYS_INLINE void batch_store_v3(double (*a)[DEM_BATCH], int e, dem_vec3 v)
+{
+    a[0][e] = v.x, a[1][e] = v.y, a[2][e] = v.z;
+}
+
+// Stage 1: geometry and kinematics of each contact (pair_geometry_of).
+static DEM_ALWAYS_INLINE void batch_geometry(const pair_ctx *restrict c, contact_batch *restrict b)
+{
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        const pair_side si = batch_side(b, e, 0), sj = batch_side(b, e, 1);
+        const dem_pair_constants pk = {b->root_reduced_mass[e], b->reduced_radius[e]};
+        const pair_geometry g = pair_geometry_of(c, BATCH_V3(b->d, e), &si, &sj, &pk);
+        batch_store_v3(b->n, e, g.s.normal);
+        batch_store_v3(b->vrel, e, g.s.vrel);
+        batch_store_v3(b->wrel, e, g.s.wrel);
+        b->overlap[e] = g.s.overlap, b->twist[e] = g.s.twist;
+        b->lever[0][e] = g.lever_i, b->lever[1][e] = g.lever_j;
+    }
+}
+
+static DEM_ALWAYS_INLINE dem_contact_state batch_state(const pair_ctx *restrict c, const contact_batch *restrict b,
+                                                       int e)
+{
+    return (dem_contact_state){BATCH_V3(b->n, e), b->overlap[e], BATCH_V3(b->vrel, e), BATCH_V3(b->wrel, e),
+                               b->twist[e], b->root_reduced_mass[e], b->reduced_radius[e], c->hist_dt};
+}
+
+// Stage 2: the normal force (into f) and what drives the springs.
+static DEM_ALWAYS_INLINE void batch_normal(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
+{
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        const dem_contact_state s = batch_state(c, b, e);
+        dem_contact_out out;
+        const dem_contact_drive drive = dem_contact_normal(&c->gg, &s, &out, mask);
+        batch_store_v3(b->f, e, out.force);
+        b->fn_abs[e] = drive.fn_abs;
+        batch_store_v3(b->vt, e, drive.vt);
+        batch_store_v3(b->vr, e, drive.vr);
+    }
+}
+
+// Stage 3: one spring carried and advanced (dem_spring_advance). `hist_row`:
+// its first row in hist (0 tangential, dem_rolling_slot rolling); `row`: its
+// first row in spring and spring_force (0 tangential, 3 rolling).
+static DEM_ALWAYS_INLINE void batch_advance(const pair_ctx *restrict c, contact_batch *restrict b, int hist_row,
+                                            int row, double (*vel)[DEM_BATCH], double k)
+{
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        const double h[3] = {b->hist[hist_row][e], b->hist[hist_row + 1][e], b->hist[hist_row + 2][e]};
+        dem_vec3 f;
+        const dem_vec3 spring =
+            dem_spring_advance(h, BATCH_V3(b->n, e), b->twist[e], BATCH_V3(vel, e), c->hist_dt, k, &f);
+        batch_store_v3(b->spring + row, e, spring);
+        batch_store_v3(b->spring_force + row, e, f);
+    }
+}
+
+// Stage 4: one spring's Coulomb limit (dem_spring_limit): its force in place
+// in spring_force, the spring into hist.
+static DEM_ALWAYS_INLINE void batch_limit(contact_batch *restrict b, int hist_row, int row, double inv_k, double mu)
+{
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        double h[3];
+        int stick;
+        const dem_vec3 f = dem_spring_limit(h, BATCH_V3(b->spring + row, e), BATCH_V3(b->spring_force + row, e),
+                                            inv_k, mu * b->fn_abs[e], &stick);
+        batch_store_v3(b->spring_force + row, e, f);
+        for (int q = 0; q < 3; ++q) b->hist[hist_row + q][e] = h[q];
+    }
+}
+
+// Stage 5: the total force (as dem_contact_eval adds it) and the torques.
+static DEM_ALWAYS_INLINE void batch_torques(contact_batch *restrict b, const unsigned mask)
+{
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        const dem_vec3 zero = dem_v3(0, 0, 0);
+        const dem_vec3 f_t = mask & DEM_FEAT_TANGENTIAL ? BATCH_V3(b->spring_force, e) : zero;
+        const dem_vec3 f_r = mask & DEM_FEAT_ROLLING ? BATCH_V3(b->spring_force + 3, e) : zero;
+        if (mask & DEM_FEAT_TANGENTIAL) batch_store_v3(b->f, e, dem_v3_add(BATCH_V3(b->f, e), f_t));
+        dem_vec3 ti, tj;
+        pair_torques(BATCH_V3(b->n, e), f_t, f_r, b->reduced_radius[e], b->lever[0][e], b->lever[1][e], &ti, &tj);
+        batch_store_v3(b->ti, e, ti);
+        batch_store_v3(b->tj, e, tj);
+    }
+}
+
+// The law over the whole batch, in stages (see dem_contact.h): each a loop
+// the compiler vectorises, with no branches and no dependence between its
+// iterations. perf put the single loop's samples on the instructions
+// waiting for its square roots and divisions, one chain after another;
+// short stages let the processor overlap them across contacts (measured,
+// 1.054x the step at N = 20 000, median of 10 interleaved rounds,
+// 1.045-1.074; the kernel's share of the samples 27 % -> 22 %).
 static DEM_ALWAYS_INLINE void batch_compute(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
 {
-    const int hl = dem_history_len(mask), count = b->count;
-    DEM_INDEPENDENT_ITERATIONS
-    for (int e = 0; e < count; ++e) {
-        const pair_side si = batch_side(b, e, 0), sj = batch_side(b, e, 1);
-        double h[6] = {0, 0, 0, 0, 0, 0};
-        for (int q = 0; q < hl; ++q) h[q] = b->hist[q][e];
-        const dem_pair_constants pk = {b->root_reduced_mass[e], b->reduced_radius[e]};
-        const pair_result r = pair_contact(c, dem_v3(b->d[0][e], b->d[1][e], b->d[2][e]), &si, &sj, &pk, h, mask);
-        for (int q = 0; q < hl; ++q) b->hist[q][e] = h[q];
-        b->f[0][e] = r.force.x, b->f[1][e] = r.force.y, b->f[2][e] = r.force.z;
-        b->ti[0][e] = r.torque_i.x, b->ti[1][e] = r.torque_i.y, b->ti[2][e] = r.torque_i.z;
-        b->tj[0][e] = r.torque_j.x, b->tj[1][e] = r.torque_j.y, b->tj[2][e] = r.torque_j.z;
-    }
+    const dem_contact_coeffs *gg = &c->gg;
+    const int rolling = dem_rolling_slot(mask);
+    batch_geometry(c, b);
+    batch_normal(c, b, mask);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_advance(c, b, 0, 0, b->vt, gg->k_s);
+    if (mask & DEM_FEAT_ROLLING) batch_advance(c, b, rolling, 3, b->vr, gg->k_r);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_limit(b, 0, 0, gg->inv_k_s, gg->mu_s);
+    if (mask & DEM_FEAT_ROLLING) batch_limit(b, rolling, 3, gg->inv_k_r, gg->mu_r);
+    batch_torques(b, mask);
 }
 
 // The batch kernel is built twice, for the x86-64 baseline (two contacts per
