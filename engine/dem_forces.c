@@ -404,21 +404,21 @@ static DEM_ALWAYS_INLINE void batch_geometry(const pair_ctx *restrict c, contact
     }
 }
 
-static DEM_ALWAYS_INLINE dem_contact_state batch_state(const pair_ctx *restrict c, const contact_batch *restrict b,
-                                                       int e)
+static DEM_ALWAYS_INLINE dem_contact_state batch_state(const contact_batch *restrict b, int e, double dt)
 {
     return (dem_contact_state){BATCH_V3(b->n, e), b->overlap[e], BATCH_V3(b->vrel, e), BATCH_V3(b->wrel, e),
-                               b->twist[e], b->root_reduced_mass[e], b->reduced_radius[e], c->hist_dt};
+                               b->twist[e], b->root_reduced_mass[e], b->reduced_radius[e], dt};
 }
 
 // Stage 2: the normal force (into f) and what drives the springs.
-static DEM_ALWAYS_INLINE void batch_normal(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
+static DEM_ALWAYS_INLINE void batch_normal(const dem_contact_coeffs *restrict cc, contact_batch *restrict b,
+                                           double dt, const unsigned mask)
 {
     DEM_INDEPENDENT_ITERATIONS
     for (int e = 0; e < b->count; ++e) {
-        const dem_contact_state s = batch_state(c, b, e);
+        const dem_contact_state s = batch_state(b, e, dt);
         dem_contact_out out;
-        const dem_contact_drive drive = dem_contact_normal(&c->gg, &s, &out, mask);
+        const dem_contact_drive drive = dem_contact_normal(cc, &s, &out, mask);
         batch_store_v3(b->f, e, out.force);
         b->fn_abs[e] = drive.fn_abs;
         batch_store_v3(b->vt, e, drive.vt);
@@ -429,15 +429,15 @@ static DEM_ALWAYS_INLINE void batch_normal(const pair_ctx *restrict c, contact_b
 // Stage 3: one spring carried and advanced (dem_spring_advance). `hist_row`:
 // its first row in hist (0 tangential, dem_rolling_slot rolling); `row`: its
 // first row in spring and spring_force (0 tangential, 3 rolling).
-static DEM_ALWAYS_INLINE void batch_advance(const pair_ctx *restrict c, contact_batch *restrict b, int hist_row,
-                                            int row, double (*vel)[DEM_BATCH], double k)
+static DEM_ALWAYS_INLINE void batch_advance(contact_batch *restrict b, int hist_row, int row,
+                                            double (*vel)[DEM_BATCH], double k, double dt)
 {
     DEM_INDEPENDENT_ITERATIONS
     for (int e = 0; e < b->count; ++e) {
         const double h[3] = {b->hist[hist_row][e], b->hist[hist_row + 1][e], b->hist[hist_row + 2][e]};
         dem_vec3 f;
         const dem_vec3 spring =
-            dem_spring_advance(h, BATCH_V3(b->n, e), b->twist[e], BATCH_V3(vel, e), c->hist_dt, k, &f);
+            dem_spring_advance(h, BATCH_V3(b->n, e), b->twist[e], BATCH_V3(vel, e), dt, k, &f);
         batch_store_v3(b->spring + row, e, spring);
         batch_store_v3(b->spring_force + row, e, f);
     }
@@ -458,16 +458,36 @@ static DEM_ALWAYS_INLINE void batch_limit(contact_batch *restrict b, int hist_ro
     }
 }
 
-// Stage 5: the total force (as dem_contact_eval adds it) and the torques.
+// The stages of the law itself, with the coefficients cc and step dt.
+static DEM_ALWAYS_INLINE void batch_law(const dem_contact_coeffs *restrict cc, contact_batch *restrict b, double dt,
+                                        const unsigned mask)
+{
+    const int rolling = dem_rolling_slot(mask);
+    batch_normal(cc, b, dt, mask);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_advance(b, 0, 0, b->vt, cc->k_s, dt);
+    if (mask & DEM_FEAT_ROLLING) batch_advance(b, rolling, 3, b->vr, cc->k_r, dt);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_limit(b, 0, 0, cc->inv_k_s, cc->mu_s);
+    if (mask & DEM_FEAT_ROLLING) batch_limit(b, rolling, 3, cc->inv_k_r, cc->mu_r);
+}
+
+// A lane's tangential and rolling forces (zero for a spring that is off),
+// and the total force into f, as dem_contact_eval adds them.
+static DEM_ALWAYS_INLINE void batch_total_force(contact_batch *restrict b, int e, dem_vec3 *f_t, dem_vec3 *f_r,
+                                                const unsigned mask)
+{
+    const dem_vec3 zero = dem_v3(0, 0, 0);
+    *f_t = mask & DEM_FEAT_TANGENTIAL ? BATCH_V3(b->spring_force, e) : zero;
+    *f_r = mask & DEM_FEAT_ROLLING ? BATCH_V3(b->spring_force + 3, e) : zero;
+    if (mask & DEM_FEAT_TANGENTIAL) batch_store_v3(b->f, e, dem_v3_add(BATCH_V3(b->f, e), *f_t));
+}
+
+// Stage 5: the total force and the torques.
 static DEM_ALWAYS_INLINE void batch_torques(contact_batch *restrict b, const unsigned mask)
 {
     DEM_INDEPENDENT_ITERATIONS
     for (int e = 0; e < b->count; ++e) {
-        const dem_vec3 zero = dem_v3(0, 0, 0);
-        const dem_vec3 f_t = mask & DEM_FEAT_TANGENTIAL ? BATCH_V3(b->spring_force, e) : zero;
-        const dem_vec3 f_r = mask & DEM_FEAT_ROLLING ? BATCH_V3(b->spring_force + 3, e) : zero;
-        if (mask & DEM_FEAT_TANGENTIAL) batch_store_v3(b->f, e, dem_v3_add(BATCH_V3(b->f, e), f_t));
-        dem_vec3 ti, tj;
+        dem_vec3 f_t, f_r, ti, tj;
+        batch_total_force(b, e, &f_t, &f_r, mask);
         pair_torques(BATCH_V3(b->n, e), f_t, f_r, b->reduced_radius[e], b->lever[0][e], b->lever[1][e], &ti, &tj);
         batch_store_v3(b->ti, e, ti);
         batch_store_v3(b->tj, e, tj);
@@ -483,15 +503,33 @@ static DEM_ALWAYS_INLINE void batch_torques(contact_batch *restrict b, const uns
 // 1.045-1.074; the kernel's share of the samples 27 % -> 22 %).
 static DEM_ALWAYS_INLINE void batch_compute(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
 {
-    const dem_contact_coeffs *gg = &c->gg;
-    const int rolling = dem_rolling_slot(mask);
     batch_geometry(c, b);
-    batch_normal(c, b, mask);
-    if (mask & DEM_FEAT_TANGENTIAL) batch_advance(c, b, 0, 0, b->vt, gg->k_s);
-    if (mask & DEM_FEAT_ROLLING) batch_advance(c, b, rolling, 3, b->vr, gg->k_r);
-    if (mask & DEM_FEAT_TANGENTIAL) batch_limit(b, 0, 0, gg->inv_k_s, gg->mu_s);
-    if (mask & DEM_FEAT_ROLLING) batch_limit(b, rolling, 3, gg->inv_k_r, gg->mu_r);
+    batch_law(&c->gg, b, c->hist_dt, mask);
     batch_torques(b, mask);
+}
+
+// Eq. 9–10 for a granule on a wall: the torque of the tangential force f_t
+// and the rolling quasi-force f_r at lever arm a and R* = R.
+static DEM_ALWAYS_INLINE dem_vec3 wall_torque(dem_vec3 n, dem_vec3 f_t, dem_vec3 f_r, double lever, double radius)
+{
+    const dem_vec3 ts = dem_v3_scale(dem_v3_cross(n, f_t), lever);
+    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, f_r), radius);
+    return dem_v3_sub(ts, tr);
+}
+
+// The law over a batch of granule–wall contacts whose geometry the wall loop
+// put in (wall_contact_into): total force into f, torque into ti.
+static DEM_ALWAYS_INLINE void wall_batch_compute(const dem_contact_coeffs *restrict cc, double dt,
+                                                 contact_batch *restrict b, const unsigned mask)
+{
+    batch_law(cc, b, dt, mask);
+    DEM_INDEPENDENT_ITERATIONS
+    for (int e = 0; e < b->count; ++e) {
+        dem_vec3 f_t, f_r;
+        batch_total_force(b, e, &f_t, &f_r, mask);
+        batch_store_v3(b->ti, e,
+                       wall_torque(BATCH_V3(b->n, e), f_t, f_r, b->lever[0][e], b->reduced_radius[e]));
+    }
 }
 
 // The batch kernel is built twice, for the x86-64 baseline (two contacts per
@@ -525,12 +563,29 @@ DEM_BATCH_KERNEL(12)
 DEM_BATCH_KERNEL(13)
 DEM_BATCH_KERNEL(14)
 DEM_BATCH_KERNEL(15)
+// The same for a batch of granule–wall contacts, per wall feature mask.
+#define DEM_WALL_KERNEL(M)                                                                               \
+    DEM_MULTIVERSION static void wall_batch_compute_##M(const dem_contact_coeffs *restrict cc, double dt, \
+                                                        contact_batch *restrict b)                       \
+    {                                                                                                    \
+        wall_batch_compute(cc, dt, b, M);                                                                \
+    }
+DEM_WALL_KERNEL(0)
+DEM_WALL_KERNEL(1)
+DEM_WALL_KERNEL(2)
+DEM_WALL_KERNEL(3)
+DEM_WALL_KERNEL(4)
+DEM_WALL_KERNEL(5)
+DEM_WALL_KERNEL(6)
+DEM_WALL_KERNEL(7)
 // The functions f0 … f15 instantiated for each feature mask, as a table.
 #define DEM_BY_MASK_8(f) {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7}
 #define DEM_BY_MASK_16(f) \
     {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7, f##8, f##9, f##10, f##11, f##12, f##13, f##14, f##15}
 typedef void (*batch_kernel_fn)(const pair_ctx *restrict, contact_batch *restrict);
 static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(batch_compute_);
+typedef void (*wall_kernel_fn)(const dem_contact_coeffs *restrict, double, contact_batch *restrict);
+static const wall_kernel_fn wall_kernels[8] = DEM_BY_MASK_8(wall_batch_compute_);
 
 // Run the batch and add its results in the pairs' order; empties it.
 static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
@@ -806,48 +861,117 @@ static inline void add_damping(double *d, double g, dem_vec3 n)
     d[3] += g * n.x * n.y, d[4] += g * n.x * n.z, d[5] += g * n.y * n.z;
 }
 
+// Geometry and kinematics of granule i against a wall (the wall a granule
+// of infinite mass and radius: m* = m_i, R* = R_i), and its lever arm; 0 if
+// it does not touch.
+static DEM_ALWAYS_INLINE int wall_contact_of(const dem_world *restrict w, const dem_wall *wall, size_t i,
+                                             dem_contact_state *s, double *lever)
+{
+    const double r = w->rad[i];
+    const dem_wall_touch t = dem_wall_geometry(&wall->def, w->pos[i], r);
+    if (!(t.overlap > 0.0)) return 0;
+    const dem_vec3 n = t.normal, wi = w->omg[i];
+    const dem_vec3 spin = dem_v3_scale(wall->def.axis, wall->def.spin);
+    *lever = r - w->lever_factor * t.overlap;
+    // The wall surface moves at Ω × (c − axis point) at the contact point c.
+    const dem_vec3 v_wall = dem_v3_cross(spin, dem_v3_sub(t.point, wall->def.point));
+    s->normal = n;
+    s->overlap = t.overlap;
+    s->vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, *lever), n)), v_wall);
+    s->wrel = dem_v3_sub(wi, spin);
+    s->twist = 0.5 * dem_v3_dot(dem_v3_add(wi, spin), n) * w->hist_dt;
+    s->root_reduced_mass = sqrt(w->mass[i]);
+    s->reduced_radius = r;
+    s->dt = w->hist_dt;
+    return 1;
+}
+
+// Granule i against a wall, one at a time: the implicit integrations, which
+// also gather the contact's damping and stiffness, come this way.
 static DEM_ALWAYS_INLINE void wall_force(dem_world *restrict w, const dem_wall *wall, size_t i, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
     double *hist = wall->hist + i * (size_t)hl;
-    const double r = w->rad[i];
-    dem_wall_touch t = dem_wall_geometry(&wall->def, w->pos[i], r);
-    if (!(t.overlap > 0.0)) {
+    dem_contact_state s;
+    double ai;
+    if (!wall_contact_of(w, wall, i, &s, &ai)) {
         for (int h = 0; h < hl; ++h) hist[h] = 0.0;
         return;
     }
-    const dem_vec3 n = t.normal, wi = w->omg[i];
-    const dem_vec3 spin = dem_v3_scale(wall->def.axis, wall->def.spin);
-    const double ai = r - w->lever_factor * t.overlap;
-    // The wall surface moves at Ω × (c − axis point) at the contact point c.
-    const dem_vec3 v_wall = dem_v3_cross(spin, dem_v3_sub(t.point, wall->def.point));
-    dem_contact_state s;
-    s.normal = n;
-    s.overlap = t.overlap;
-    s.vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, ai), n)), v_wall);
-    s.wrel = dem_v3_sub(wi, spin);
-    s.twist = 0.5 * dem_v3_dot(dem_v3_add(wi, spin), n) * w->hist_dt;
-    s.root_reduced_mass = sqrt(w->mass[i]); // infinite wall mass: m* = m_i
-    s.reduced_radius = r;        // infinite wall radius: R* = R_i
-    s.dt = w->hist_dt;
+    const dem_vec3 n = s.normal;
+    const double r = s.reduced_radius;
     dem_contact_out out;
     dem_contact_eval(&wall->coeffs, &s, hist, &out, mask);
     w->frc[i] = dem_v3_add(w->frc[i], out.force);
     if ((mask & DEM_FEAT_DAMPING) && w->def.implicit_damping) add_damping(w->damp + 6 * i, out.damping_coeff, n);
     if (w->imp.on)
         dem_imp_add_block(w->imp.wall + 36 * i, n, out.damping_coeff, out.k_tangential, out.k_rolling, ai, r, w->dt);
-    const dem_vec3 ts = dem_v3_scale(dem_v3_cross(n, out.f_tangential), ai);
-    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, out.f_rolling), r);
-    w->trq[i] = dem_v3_add(w->trq[i], dem_v3_sub(ts, tr));
+    w->trq[i] = dem_v3_add(w->trq[i], wall_torque(n, out.f_tangential, out.f_rolling, ai, r));
+}
+
+// Run a batch of wall contacts and add each to its granule; empties it.
+static DEM_ALWAYS_INLINE void wall_flush(dem_world *restrict w, const dem_wall *wall, contact_batch *restrict b,
+                                         const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    wall_kernels[mask & 7u](&wall->coeffs, w->hist_dt, b);
+    for (int e = 0; e < b->count; ++e) {
+        const size_t i = b->i[e];
+        double *restrict hist = wall->hist + i * (size_t)hl;
+        for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
+        w->frc[i] = dem_v3_add(w->frc[i], BATCH_V3(b->f, e));
+        w->trq[i] = dem_v3_add(w->trq[i], BATCH_V3(b->ti, e));
+    }
+    b->count = 0;
+}
+
+// The near granules near[0 … count−1] against a wall. In the explicit
+// integration the touching ones go through a contact batch, whose law runs
+// in stages as the pairs' does: at the calibration's scale (279 granules)
+// the walls took a fifth of the time one contact at a time (measured, the
+// drum run 1.09x faster batched, 1.039x at N = 20 000). Each granule meets
+// the wall once, so the additions are those of the one-at-a-time loop.
+static DEM_ALWAYS_INLINE void wall_contacts(dem_world *restrict w, const dem_wall *wall, const uint32_t *near,
+                                            size_t count, const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    if (w->def.implicit_damping || w->imp.on) {
+        for (size_t k = 0; k < count; ++k) wall_force(w, wall, near[k], mask);
+        return;
+    }
+    contact_batch b;
+    b.count = 0;
+    for (size_t k = 0; k < count; ++k) {
+        const size_t i = near[k];
+        double *restrict hist = wall->hist + i * (size_t)hl;
+        dem_contact_state s;
+        double lever;
+        if (!wall_contact_of(w, wall, i, &s, &lever)) {
+            for (int h = 0; h < hl; ++h) hist[h] = 0.0; // a new contact starts unloaded
+            continue;
+        }
+        const int e = b.count++;
+        b.i[e] = (uint32_t)i;
+        batch_store_v3(b.n, e, s.normal);
+        batch_store_v3(b.vrel, e, s.vrel);
+        batch_store_v3(b.wrel, e, s.wrel);
+        b.overlap[e] = s.overlap, b.twist[e] = s.twist, b.lever[0][e] = lever;
+        b.root_reduced_mass[e] = s.root_reduced_mass, b.reduced_radius[e] = s.reduced_radius;
+        for (int q = 0; q < hl; ++q) b.hist[q][e] = hist[q];
+        if (b.count == DEM_BATCH) wall_flush(w, wall, &b, mask);
+    }
+    if (b.count) wall_flush(w, wall, &b, mask);
 }
 
 // Only the granules near the wall (dem_wall.near): the others are out of reach.
 static DEM_ALWAYS_INLINE void wall_loop(dem_world *restrict w, const dem_wall *wall, const unsigned mask)
 {
-    const size_t n = wall->near_count;
-    const uint32_t *near = wall->near;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
-    for (size_t k = 0; k < n; ++k) wall_force(w, wall, near[k], mask);
+#pragma omp parallel if (w->n >= DEM_OMP_MIN_GRANULES)
+    {
+        size_t lo, hi;
+        dem_thread_block(wall->near_count, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
+        wall_contacts(w, wall, wall->near + lo, hi - lo, mask);
+    }
 }
 
 // Granules [lo, hi) of one thread's block that are near the wall (the near
@@ -862,7 +986,9 @@ static DEM_ALWAYS_INLINE void wall_block(dem_world *restrict w, const dem_wall *
         if (near[m] < lo) a = m + 1;
         else b = m;
     }
-    for (size_t k = a; k < wall->near_count && near[k] < hi; ++k) wall_force(w, wall, near[k], mask);
+    size_t end = a;
+    while (end < wall->near_count && near[end] < hi) ++end;
+    wall_contacts(w, wall, near + a, end - a, mask);
 }
 
 // One specialised function per feature mask; the table picks it per scene.
