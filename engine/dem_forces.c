@@ -388,6 +388,18 @@ static DEM_ALWAYS_INLINE void batch_store_v3(double (*a)[DEM_BATCH], int e, dem_
     a[0][e] = v.x, a[1][e] = v.y, a[2][e] = v.z;
 }
 
+// A contact's geometry and kinematics into lane e (its sqrt(m*) and R* are
+// there already).
+static DEM_ALWAYS_INLINE void batch_put_state(contact_batch *restrict b, int e, const dem_contact_state *s,
+                                              double lever_i, double lever_j)
+{
+    batch_store_v3(b->n, e, s->normal);
+    batch_store_v3(b->vrel, e, s->vrel);
+    batch_store_v3(b->wrel, e, s->wrel);
+    b->overlap[e] = s->overlap, b->twist[e] = s->twist;
+    b->lever[0][e] = lever_i, b->lever[1][e] = lever_j;
+}
+
 // Stage 1: geometry and kinematics of each contact (pair_geometry_of).
 static DEM_ALWAYS_INLINE void batch_geometry(const pair_ctx *restrict c, contact_batch *restrict b)
 {
@@ -396,11 +408,7 @@ static DEM_ALWAYS_INLINE void batch_geometry(const pair_ctx *restrict c, contact
         const pair_side si = batch_side(b, e, 0), sj = batch_side(b, e, 1);
         const dem_pair_constants pk = {b->root_reduced_mass[e], b->reduced_radius[e]};
         const pair_geometry g = pair_geometry_of(c, BATCH_V3(b->d, e), &si, &sj, &pk);
-        batch_store_v3(b->n, e, g.s.normal);
-        batch_store_v3(b->vrel, e, g.s.vrel);
-        batch_store_v3(b->wrel, e, g.s.wrel);
-        b->overlap[e] = g.s.overlap, b->twist[e] = g.s.twist;
-        b->lever[0][e] = g.lever_i, b->lever[1][e] = g.lever_j;
+        batch_put_state(b, e, &g.s, g.lever_i, g.lever_j);
     }
 }
 
@@ -518,7 +526,7 @@ static DEM_ALWAYS_INLINE dem_vec3 wall_torque(dem_vec3 n, dem_vec3 f_t, dem_vec3
 }
 
 // The law over a batch of granule–wall contacts whose geometry the wall loop
-// put in (wall_contact_into): total force into f, torque into ti.
+// put in (wall_contacts): total force into f, torque into ti.
 static DEM_ALWAYS_INLINE void wall_batch_compute(const dem_contact_coeffs *restrict cc, double dt,
                                                  contact_batch *restrict b, const unsigned mask)
 {
@@ -952,11 +960,8 @@ static DEM_ALWAYS_INLINE void wall_contacts(dem_world *restrict w, const dem_wal
         }
         const int e = b.count++;
         b.i[e] = (uint32_t)i;
-        batch_store_v3(b.n, e, s.normal);
-        batch_store_v3(b.vrel, e, s.vrel);
-        batch_store_v3(b.wrel, e, s.wrel);
-        b.overlap[e] = s.overlap, b.twist[e] = s.twist, b.lever[0][e] = lever;
         b.root_reduced_mass[e] = s.root_reduced_mass, b.reduced_radius[e] = s.reduced_radius;
+        batch_put_state(&b, e, &s, lever, 0.0);
         for (int q = 0; q < hl; ++q) b.hist[q][e] = hist[q];
         if (b.count == DEM_BATCH) wall_flush(w, wall, &b, mask);
     }
