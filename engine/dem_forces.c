@@ -138,9 +138,15 @@ static inline pair_ctx pair_ctx_make(const dem_world *w)
                       w->def.periodic_axis, w->def.implicit_damping, w->imp.on};
 }
 
-// Whether the pairs go through the contact batch: the implicit integrations
-// keep per-pair data (pair_g, imp.pair) that only the scalar pair_force writes.
-static inline int uses_batch(const pair_ctx *c) { return !c->implicit_damping && !c->implicit_springs; }
+// Whether contacts go through the contact batch: the implicit integrations
+// keep per-pair and per-wall-contact data (pair_g, imp.pair, damp, imp.wall)
+// that only the one-at-a-time paths write. The one rule, for the pairs, the
+// walls and the step team (dem_forces_blockwise) alike.
+static inline int contacts_batched(int implicit_damping, int implicit_springs)
+{
+    return !implicit_damping && !implicit_springs;
+}
+static inline int uses_batch(const pair_ctx *c) { return contacts_batched(c->implicit_damping, c->implicit_springs); }
 
 // Add the slot of pair k, which crosses a thread's block, to its granule i.
 static DEM_ALWAYS_INLINE void add_slot(const pair_ctx *restrict c, size_t i, size_t k)
@@ -943,7 +949,7 @@ static DEM_ALWAYS_INLINE void wall_contacts(dem_world *restrict w, const dem_wal
                                             size_t count, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
-    if (w->def.implicit_damping || w->imp.on) {
+    if (!contacts_batched(w->def.implicit_damping, w->imp.on)) {
         for (size_t k = 0; k < count; ++k) wall_force(w, wall, near[k], mask);
         return;
     }
@@ -1064,7 +1070,10 @@ static void gather_damping(dem_world *restrict w)
     }
 }
 
-int dem_forces_blockwise(const dem_world *w) { return !w->def.implicit_damping && !w->def.implicit_springs; }
+int dem_forces_blockwise(const dem_world *w)
+{
+    return contacts_batched(w->def.implicit_damping, w->def.implicit_springs);
+}
 
 size_t dem_forces_crossing_rows(const dem_world *w, size_t lo, size_t hi, uint32_t *rows)
 {
