@@ -222,15 +222,23 @@ static DEM_ALWAYS_INLINE pair_geometry pair_geometry_of(const pair_ctx *restrict
     return g;
 }
 
-// Eq. 9–10: the torques on i and on j of a contact's tangential force f_t
-// and rolling quasi-force f_r.
+// Eq. 9–10: the torque on granule i (lever arm lever_i) of a contact's
+// tangential force f_t and rolling quasi-force f_r; for a wall contact the
+// only torque, with R* = R_i.
+static DEM_ALWAYS_INLINE dem_vec3 torque_on_i(dem_vec3 n, dem_vec3 f_t, dem_vec3 f_r, double reduced_radius,
+                                              double lever_i)
+{
+    const dem_vec3 ts = dem_v3_scale(dem_v3_cross(n, f_t), lever_i);
+    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, f_r), reduced_radius);
+    return dem_v3_sub(ts, tr);
+}
+
+// Eq. 9–10: the torques on i and on j of a granule–granule contact.
 static DEM_ALWAYS_INLINE void pair_torques(dem_vec3 n, dem_vec3 f_t, dem_vec3 f_r, double reduced_radius,
                                            double lever_i, double lever_j, dem_vec3 *ti, dem_vec3 *tj)
 {
-    const dem_vec3 ts = dem_v3_cross(n, f_t);
-    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, f_r), reduced_radius);
-    *ti = dem_v3_sub(dem_v3_scale(ts, lever_i), tr);
-    *tj = dem_v3_add(dem_v3_scale(ts, lever_j), tr);
+    *ti = torque_on_i(n, f_t, f_r, reduced_radius, lever_i);
+    *tj = dem_v3_add(dem_v3_scale(dem_v3_cross(n, f_t), lever_j), dem_v3_scale(dem_v3_cross(n, f_r), reduced_radius));
 }
 
 // The contact of a touching pair, one pair at a time: geometry, the law
@@ -369,6 +377,17 @@ static DEM_ALWAYS_INLINE void batch_put_side(contact_batch *restrict b, int e, i
     b->rad[side][e] = s->rad;
     const double v[3] = {s->vel.x, s->vel.y, s->vel.z}, o[3] = {s->omg.x, s->omg.y, s->omg.z};
     for (int q = 0; q < 3; ++q) b->vel[3 * side + q][e] = v[q], b->omg[3 * side + q][e] = o[q];
+}
+
+// A contact's hl doubles of history into lane e, and back out of it.
+static DEM_ALWAYS_INLINE void batch_hist_in(contact_batch *restrict b, int e, const double *restrict hist, int hl)
+{
+    for (int q = 0; q < hl; ++q) b->hist[q][e] = hist[q];
+}
+
+static DEM_ALWAYS_INLINE void batch_hist_out(const contact_batch *restrict b, int e, double *restrict hist, int hl)
+{
+    for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
 }
 
 static DEM_ALWAYS_INLINE pair_side batch_side(const contact_batch *restrict b, int e, int side)
@@ -522,15 +541,6 @@ static DEM_ALWAYS_INLINE void batch_compute(const pair_ctx *restrict c, contact_
     batch_torques(b, mask);
 }
 
-// Eq. 9–10 for a granule on a wall: the torque of the tangential force f_t
-// and the rolling quasi-force f_r at lever arm a and R* = R.
-static DEM_ALWAYS_INLINE dem_vec3 wall_torque(dem_vec3 n, dem_vec3 f_t, dem_vec3 f_r, double lever, double radius)
-{
-    const dem_vec3 ts = dem_v3_scale(dem_v3_cross(n, f_t), lever);
-    const dem_vec3 tr = dem_v3_scale(dem_v3_cross(n, f_r), radius);
-    return dem_v3_sub(ts, tr);
-}
-
 // The law over a batch of granule–wall contacts whose geometry the wall loop
 // put in (wall_contacts): total force into f, torque into ti.
 static DEM_ALWAYS_INLINE void wall_batch_compute(const dem_contact_coeffs *restrict cc, double dt,
@@ -542,7 +552,7 @@ static DEM_ALWAYS_INLINE void wall_batch_compute(const dem_contact_coeffs *restr
         dem_vec3 f_t, f_r;
         batch_total_force(b, e, &f_t, &f_r, mask);
         batch_store_v3(b->ti, e,
-                       wall_torque(BATCH_V3(b->n, e), f_t, f_r, b->lever[0][e], b->reduced_radius[e]));
+                       torque_on_i(BATCH_V3(b->n, e), f_t, f_r, b->reduced_radius[e], b->lever[0][e]));
     }
 }
 
@@ -611,8 +621,7 @@ static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_ba
             add_slot(c, b->i[e], b->k[e]);
             continue;
         }
-        double *restrict hist = c->hist + b->k[e] * (size_t)hl;
-        for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
+        batch_hist_out(b, e, c->hist + b->k[e] * (size_t)hl, hl);
         add_to_pair(c, b->i[e], b->j[e], dem_v3(b->f[0][e], b->f[1][e], b->f[2][e]),
                     dem_v3(b->ti[0][e], b->ti[1][e], b->ti[2][e]), dem_v3(b->tj[0][e], b->tj[1][e], b->tj[2][e]));
     }
@@ -680,7 +689,7 @@ static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_
     const pair_side si = side_of(c, i), sj = side_of(c, j);
     batch_put_side(b, e, 0, &si);
     batch_put_side(b, e, 1, &sj);
-    for (int q = 0; q < hl; ++q) b->hist[q][e] = hist[q];
+    batch_hist_in(b, e, hist, hl);
     if (b->count == DEM_BATCH) batch_flush(c, b, mask);
 }
 
@@ -920,7 +929,7 @@ static DEM_ALWAYS_INLINE void wall_force(dem_world *restrict w, const dem_wall *
     if ((mask & DEM_FEAT_DAMPING) && w->def.implicit_damping) add_damping(w->damp + 6 * i, out.damping_coeff, n);
     if (w->imp.on)
         dem_imp_add_block(w->imp.wall + 36 * i, n, out.damping_coeff, out.k_tangential, out.k_rolling, ai, r, w->dt);
-    w->trq[i] = dem_v3_add(w->trq[i], wall_torque(n, out.f_tangential, out.f_rolling, ai, r));
+    w->trq[i] = dem_v3_add(w->trq[i], torque_on_i(n, out.f_tangential, out.f_rolling, r, ai));
 }
 
 // Run a batch of wall contacts and add each to its granule; empties it.
@@ -931,8 +940,7 @@ static DEM_ALWAYS_INLINE void wall_flush(dem_world *restrict w, const dem_wall *
     wall_kernels[mask & 7u](&wall->coeffs, w->hist_dt, b);
     for (int e = 0; e < b->count; ++e) {
         const size_t i = b->i[e];
-        double *restrict hist = wall->hist + i * (size_t)hl;
-        for (int q = 0; q < hl; ++q) hist[q] = b->hist[q][e];
+        batch_hist_out(b, e, wall->hist + i * (size_t)hl, hl);
         w->frc[i] = dem_v3_add(w->frc[i], BATCH_V3(b->f, e));
         w->trq[i] = dem_v3_add(w->trq[i], BATCH_V3(b->ti, e));
     }
@@ -968,7 +976,7 @@ static DEM_ALWAYS_INLINE void wall_contacts(dem_world *restrict w, const dem_wal
         b.i[e] = (uint32_t)i;
         b.root_reduced_mass[e] = s.root_reduced_mass, b.reduced_radius[e] = s.reduced_radius;
         batch_put_state(&b, e, &s, lever, 0.0);
-        for (int q = 0; q < hl; ++q) b.hist[q][e] = hist[q];
+        batch_hist_in(&b, e, hist, hl);
         if (b.count == DEM_BATCH) wall_flush(w, wall, &b, mask);
     }
     if (b.count) wall_flush(w, wall, &b, mask);

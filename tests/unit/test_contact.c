@@ -63,7 +63,7 @@ static dem_contact_state base_state(void)
     s.vrel = dem_v3(0, 0, 0);
     s.wrel = dem_v3(0, 0, 0);
     s.twist = 0.0;
-    s.root_reduced_mass = 0.5; // m* = 0.25 (M_STAR)
+    s.root_reduced_mass = sqrt(M_STAR);
     s.reduced_radius = 0.5;
     s.dt = 1e-3;
     return s;
