@@ -481,8 +481,16 @@ static int evaluate(dem_world *w)
     return dem_implicit_solve(w);
 }
 
-// Wrap one coordinate into [lo, lo + len) of the periodic axis.
-static DEM_ALWAYS_INLINE double wrap_into(double x, double lo, double len) { return x - len * floor((x - lo) / len); }
+// Wrap one coordinate into [lo, lo + len) of the periodic axis. A centre
+// still inside (0 <= x - lo < len, as rounded) keeps x, bit for bit what the
+// formula gives: u = x - lo < len makes u/len < 1 - 2^-53, which rounds below
+// 1, so the floor is 0 and x - len·0 is x. Skipping the division there took
+// the drift's longest chain away (perf put a third of its samples on it).
+static DEM_ALWAYS_INLINE double wrap_into(double x, double lo, double len)
+{
+    const double u = x - lo;
+    return u >= 0.0 && u < len ? x : x - len * floor(u / len);
+}
 
 // Half kick and drift of granule i; 0 if it left the domain.
 static DEM_ALWAYS_INLINE int kick_drift_one(const kick_ctx *restrict c, size_t i, const kick_mode mode)
