@@ -122,7 +122,7 @@ typedef struct pair_ctx {
     dem_vec3 *frc, *trq;
     const uint32_t *nbr, *row; // partner and row (granule i) of each pair
     double *hist;
-    const dem_vec3 *slot_f, *slot_ti; // pairs crossing a thread's block: force and torque on i
+    dem_vec3 *slot_f, *slot_ti, *slot_tj; // pairs crossing a thread's block: force, torques on i and j
     dem_contact_coeffs gg;
     double half_lever; // ½ lever_factor: lever arm R − ½h (or R)
     double hist_dt;
@@ -134,7 +134,7 @@ typedef struct pair_ctx {
 static inline pair_ctx pair_ctx_make(const dem_world *w)
 {
     return (pair_ctx){w->pos, w->vel, w->omg, w->rad, w->nl.constants, w->frc, w->trq, w->nl.j, w->nl.row, w->nl.hist,
-                      w->pair_f, w->pair_ti, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
+                      w->pair_f, w->pair_ti, w->pair_tj, w->gg, 0.5 * w->lever_factor, w->hist_dt, dem_world_period(w),
                       w->def.periodic_axis, w->def.implicit_damping, w->imp.on};
 }
 
@@ -628,6 +628,23 @@ static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_ba
     b->count = 0;
 }
 
+// Run a batch of pairs crossing a thread's block and put each result in its
+// pair's slot, for the threads to add in their turn; empties it.
+static DEM_ALWAYS_INLINE void batch_flush_to_slots(const pair_ctx *restrict c, contact_batch *restrict b,
+                                                   const unsigned mask)
+{
+    const int hl = dem_history_len(mask);
+    batch_kernels[mask & (DEM_FEAT_COUNT_MASKS - 1)](c, b);
+    for (int e = 0; e < b->count; ++e) {
+        const size_t k = b->k[e];
+        batch_hist_out(b, e, c->hist + k * (size_t)hl, hl);
+        c->slot_f[k] = BATCH_V3(b->f, e);
+        c->slot_ti[k] = BATCH_V3(b->ti, e);
+        c->slot_tj[k] = BATCH_V3(b->tj, e);
+    }
+    b->count = 0;
+}
+
 // The slot of pair k, crossing the thread's block, added to row i in its
 // turn. Not flushing the batch here keeps the batches full near a block's
 // end, where most rows have such a pair.
@@ -674,9 +691,10 @@ static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_
     __builtin_prefetch(c->trq + j, 0, 2);
 }
 
-// Touching pair k (i, j, separation d) into the batch, flushing it when full.
+// Touching pair k (i, j, separation d) into the batch, flushing it when full
+// into the granules, or with `to_slots` into the pairs' slots.
 static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_batch *restrict b, size_t i,
-                                            uint32_t j, size_t k, dem_vec3 d, const unsigned mask)
+                                            uint32_t j, size_t k, dem_vec3 d, const unsigned mask, const int to_slots)
 {
     const int hl = dem_history_len(mask);
     const double *restrict hist = c->hist + k * (size_t)hl;
@@ -690,7 +708,9 @@ static DEM_ALWAYS_INLINE void batch_contact(const pair_ctx *restrict c, contact_
     batch_put_side(b, e, 0, &si);
     batch_put_side(b, e, 1, &sj);
     batch_hist_in(b, e, hist, hl);
-    if (b->count == DEM_BATCH) batch_flush(c, b, mask);
+    if (b->count < DEM_BATCH) return;
+    if (to_slots) batch_flush_to_slots(c, b, mask);
+    else batch_flush(c, b, mask);
 }
 
 // Pair k of row i into the batch if it touches (flushing a full batch);
@@ -701,7 +721,7 @@ static DEM_ALWAYS_INLINE void batch_pair(dem_world *restrict w, const pair_ctx *
 {
     const int hl = dem_history_len(mask);
     dem_vec3 d;
-    if (pair_touches(w, c, i, c->nbr[k], mask, &d)) batch_contact(c, b, i, c->nbr[k], k, d, mask);
+    if (pair_touches(w, c, i, c->nbr[k], mask, &d)) batch_contact(c, b, i, c->nbr[k], k, d, mask, 0);
     else
         for (int h = 0; h < hl; ++h) c->hist[k * (size_t)hl + h] = 0.0; // a new contact starts unloaded
 }
@@ -755,7 +775,7 @@ static DEM_ALWAYS_INLINE void batch_pairs(dem_world *restrict w, const pair_ctx 
         for (int t = 0; t < nt; ++t) {
             const size_t k = take[t];
             if (crossing[t]) batch_slot(c, b, row[k], k, mask);
-            else batch_contact(c, b, row[k], nbr[k], k, sep[t], mask);
+            else batch_contact(c, b, row[k], nbr[k], k, sep[t], mask, 0);
         }
     }
 }
@@ -814,17 +834,54 @@ static DEM_ALWAYS_INLINE void row_crossing_pairs(dem_world *restrict w, const pa
     for (size_t k = start[i + 1]; k > start[i] && c->nbr[k - 1] >= end; --k) pair_force(w, c, i, k - 1, mask, DEM_SLOTS);
 }
 
-static DEM_ALWAYS_INLINE void block_crossing_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
+// The same through a contact batch (the explicit integration): the touching
+// pairs are computed 32 at a time into their slots, the open ones' springs
+// and slots are reset. Each pair writes only its own slot and springs, so
+// the order of the batch changes nothing. Measured against one pair at a
+// time (the crossing pairs are ~2 % of the pairs at N = 100 000 on 2
+// threads, but took ~5 % of the step):
+static DEM_ALWAYS_INLINE void row_crossing_pairs_batched(dem_world *restrict w, const pair_ctx *restrict c,
+                                                         contact_batch *restrict b, size_t i, size_t end,
+                                                         const unsigned mask)
+{
+    const size_t *start = w->nl.start;
+    const int hl = dem_history_len(mask);
+    for (size_t k = start[i + 1]; k > start[i] && c->nbr[k - 1] >= end; --k) {
+        dem_vec3 d;
+        if (pair_touches(w, c, i, c->nbr[k - 1], mask, &d)) {
+            batch_contact(c, b, i, c->nbr[k - 1], k - 1, d, mask, 1);
+            continue;
+        }
+        for (int h = 0; h < hl; ++h) c->hist[(k - 1) * (size_t)hl + h] = 0.0; // a new contact starts unloaded
+        c->slot_f[k - 1] = c->slot_ti[k - 1] = c->slot_tj[k - 1] = dem_v3(0, 0, 0);
+    }
+}
+
+// Rows rows[0 … count−1] (or, without `rows`, every row of [first, end)) of
+// a block ending at `end`: their pairs reaching past it, into their slots.
+static DEM_ALWAYS_INLINE void crossing_pairs_of(dem_world *restrict w, const uint32_t *rows, size_t first,
+                                                size_t count, size_t end, const unsigned mask)
 {
     const pair_ctx c = pair_ctx_make(w);
-    for (size_t i = lo; i < hi; ++i) row_crossing_pairs(w, &c, i, hi, mask);
+    if (!uses_batch(&c)) {
+        for (size_t r = 0; r < count; ++r) row_crossing_pairs(w, &c, rows ? rows[r] : first + r, end, mask);
+        return;
+    }
+    contact_batch b;
+    b.count = 0;
+    for (size_t r = 0; r < count; ++r) row_crossing_pairs_batched(w, &c, &b, rows ? rows[r] : first + r, end, mask);
+    batch_flush_to_slots(&c, &b, mask);
+}
+
+static DEM_ALWAYS_INLINE void block_crossing_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
+{
+    crossing_pairs_of(w, NULL, lo, hi - lo, hi, mask);
 }
 
 static DEM_ALWAYS_INLINE void listed_crossing_pairs(dem_world *restrict w, const uint32_t *rows, size_t count,
                                                     size_t end, const unsigned mask)
 {
-    const pair_ctx c = pair_ctx_make(w);
-    for (size_t r = 0; r < count; ++r) row_crossing_pairs(w, &c, rows[r], end, mask);
+    crossing_pairs_of(w, rows, 0, count, end, mask);
 }
 
 static DEM_ALWAYS_INLINE void block_own_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
