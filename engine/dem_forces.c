@@ -826,34 +826,29 @@ static DEM_ALWAYS_INLINE void pair_loop_serial(dem_world *restrict w, const unsi
 // N = 100 000, against 1.95x for two separate processes).
 
 // The pairs of row i (in a block ending at `end`) that reach past the
-// block's end, into their slots.
-static DEM_ALWAYS_INLINE void row_crossing_pairs(dem_world *restrict w, const pair_ctx *restrict c, size_t i,
-                                                 size_t end, const unsigned mask)
-{
-    const size_t *start = w->nl.start;
-    for (size_t k = start[i + 1]; k > start[i] && c->nbr[k - 1] >= end; --k) pair_force(w, c, i, k - 1, mask, DEM_SLOTS);
-}
-
-// The same through a contact batch (the explicit integration): the touching
-// pairs are computed 32 at a time into their slots, the open ones' springs
-// and slots are reset. Each pair writes only its own slot and springs, so
-// the order of the batch changes nothing. The crossing pairs are ~2 % of the
-// pairs at N = 100 000 on 2 threads; one at a time they took 4.9 % of the
-// samples, batched 3.6 % (commit fcd6044).
-static DEM_ALWAYS_INLINE void row_crossing_pairs_batched(dem_world *restrict w, const pair_ctx *restrict c,
-                                                         contact_batch *restrict b, size_t i, size_t end,
-                                                         const unsigned mask)
+// block's end, into their slots: one at a time without a batch (the
+// implicit integrations), or through the contact batch b, whose touching
+// pairs are computed 32 at a time while an open pair's springs and slots are
+// reset here. Each pair writes only its own slot and springs, so the order
+// of the batch changes nothing. The crossing pairs are ~2 % of the pairs at
+// N = 100 000 on 2 threads; one at a time they took 4.9 % of the samples,
+// batched 3.6 % (commit fcd6044).
+static DEM_ALWAYS_INLINE void row_crossing_pairs(dem_world *restrict w, const pair_ctx *restrict c,
+                                                 contact_batch *b, size_t i, size_t end, const unsigned mask)
 {
     const size_t *start = w->nl.start;
     const int hl = dem_history_len(mask);
     for (size_t k = start[i + 1]; k > start[i] && c->nbr[k - 1] >= end; --k) {
+        const size_t p = k - 1;
         dem_vec3 d;
-        if (pair_touches(w, c, i, c->nbr[k - 1], mask, &d)) {
-            batch_contact(c, b, i, c->nbr[k - 1], k - 1, d, mask, 1);
-            continue;
+        if (!b) {
+            pair_force(w, c, i, p, mask, DEM_SLOTS);
+        } else if (pair_touches(w, c, i, c->nbr[p], mask, &d)) {
+            batch_contact(c, b, i, c->nbr[p], p, d, mask, 1);
+        } else {
+            for (int h = 0; h < hl; ++h) c->hist[p * (size_t)hl + h] = 0.0; // a new contact starts unloaded
+            c->slot_f[p] = c->slot_ti[p] = c->slot_tj[p] = dem_v3(0, 0, 0);
         }
-        for (int h = 0; h < hl; ++h) c->hist[(k - 1) * (size_t)hl + h] = 0.0; // a new contact starts unloaded
-        c->slot_f[k - 1] = c->slot_ti[k - 1] = c->slot_tj[k - 1] = dem_v3(0, 0, 0);
     }
 }
 
@@ -863,14 +858,11 @@ static DEM_ALWAYS_INLINE void crossing_pairs_of(dem_world *restrict w, const uin
                                                 size_t count, size_t end, const unsigned mask)
 {
     const pair_ctx c = pair_ctx_make(w);
-    if (!uses_batch(&c)) {
-        for (size_t r = 0; r < count; ++r) row_crossing_pairs(w, &c, rows ? rows[r] : first + r, end, mask);
-        return;
-    }
     contact_batch b;
     b.count = 0;
-    for (size_t r = 0; r < count; ++r) row_crossing_pairs_batched(w, &c, &b, rows ? rows[r] : first + r, end, mask);
-    batch_flush_to_slots(&c, &b, mask);
+    contact_batch *batch = uses_batch(&c) ? &b : NULL;
+    for (size_t r = 0; r < count; ++r) row_crossing_pairs(w, &c, batch, rows ? rows[r] : first + r, end, mask);
+    if (batch) batch_flush_to_slots(&c, batch, mask);
 }
 
 static DEM_ALWAYS_INLINE void block_crossing_pairs(dem_world *restrict w, size_t lo, size_t hi, const unsigned mask)
