@@ -714,12 +714,18 @@ static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_
 // 1.16x (1.07-1.27, 4 rounds) at 10^6 against 1.07x for the second lines
 // alone, 1.10x at 10^5, 1.04x at 20 000, 1.01x at 5 000; 2 threads at 10^5
 // 1.21x (1.05-1.28, 6 rounds). Bitwise the same results.
-static DEM_ALWAYS_INLINE void prefetch_springs(const pair_ctx *restrict c, size_t k, size_t end, int hl)
+// The hl doubles of springs at h, both their lines, for writing; none
+// without springs (hl = 0, where the history array may not exist).
+static DEM_ALWAYS_INLINE void prefetch_springs_at(const double *h, int hl)
 {
-    if (k + DEM_PREFETCH_AHEAD >= end) return;
-    const double *h = c->hist + (k + DEM_PREFETCH_AHEAD) * (size_t)hl;
+    if (hl == 0) return;
     __builtin_prefetch(h, 1, 2);
     __builtin_prefetch(h + hl - 1, 1, 2);
+}
+
+static DEM_ALWAYS_INLINE void prefetch_springs(const pair_ctx *restrict c, size_t k, size_t end, int hl)
+{
+    if (k + DEM_PREFETCH_AHEAD < end) prefetch_springs_at(c->hist + (k + DEM_PREFETCH_AHEAD) * (size_t)hl, hl);
 }
 
 // Touching pair k (i, j, separation d) into the batch, flushing it when full
@@ -1050,9 +1056,7 @@ static DEM_ALWAYS_INLINE void prefetch_near_granule(const dem_world *restrict w,
     __builtin_prefetch(w->mass + a, 0, 2);
     prefetch_vec3(w->frc + a);
     prefetch_vec3(w->trq + a);
-    const double *h = wall->hist + a * (size_t)hl;
-    __builtin_prefetch(h, 1, 2);
-    __builtin_prefetch(h + hl - 1, 1, 2);
+    prefetch_springs_at(wall->hist + a * (size_t)hl, hl);
 }
 
 // The near granules near[0 … count−1] against a wall. In the explicit
