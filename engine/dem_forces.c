@@ -704,16 +704,6 @@ static DEM_ALWAYS_INLINE void prefetch_partner(const pair_ctx *restrict c, size_
     prefetch_vec3(c->trq + j);
 }
 
-// The springs of the pair DEM_PREFETCH_AHEAD on, both their lines, for
-// writing: every listed pair writes its springs (a contact advances them,
-// an open pair resets them), and stores to lines not yet held stalled the
-// loop (perf at 10^6: the open pairs' reset and the batch's loads of the
-// springs). The hardware prefetcher follows the stream, but not far enough
-// ahead of a loop that only stores to most of it. Measured on top of the
-// partners' second lines, interleaved A/B against neither, 1 thread:
-// 1.16x (1.07-1.27, 4 rounds) at 10^6 against 1.07x for the second lines
-// alone, 1.10x at 10^5, 1.04x at 20 000, 1.01x at 5 000; 2 threads at 10^5
-// 1.21x (1.05-1.28, 6 rounds). Bitwise the same results.
 // The hl doubles of springs at h, both their lines, for writing; none
 // without springs (hl = 0, where the history array may not exist).
 static DEM_ALWAYS_INLINE void prefetch_springs_at(const double *h, int hl)
@@ -723,9 +713,24 @@ static DEM_ALWAYS_INLINE void prefetch_springs_at(const double *h, int hl)
     __builtin_prefetch(h + hl - 1, 1, 2);
 }
 
-static DEM_ALWAYS_INLINE void prefetch_springs(const pair_ctx *restrict c, size_t k, size_t end, int hl)
+// The springs (both their lines, for writing) and the constants of the pair
+// DEM_PREFETCH_AHEAD on. Every listed pair writes its springs (a contact
+// advances them, an open pair resets them), and stores to lines not yet held
+// stalled the loop (perf at 10^6: the open pairs' reset and the batch's
+// loads of the springs). The hardware prefetcher follows the stream, but not
+// far enough ahead of a loop that only stores to most of it. Measured on top
+// of the partners' second lines, interleaved A/B against neither, 1 thread:
+// 1.16x (1.07-1.27, 4 rounds) at 10^6 against 1.07x for the second lines
+// alone, 1.10x at 10^5, 1.04x at 20 000, 1.01x at 5 000; 2 threads at 10^5
+// 1.21x (1.05-1.28, 6 rounds). The constants, read by touching pairs only,
+// then still stalled the batch's gather at 10^6; asked for as well: 1.03x
+// (1.02-1.03, 3 rounds) at 10^6, 1.04x (1.01-1.07, 6 rounds) at 10^5,
+// 1.01x at 20 000 and 5 000 (8 rounds each). Bitwise the same results.
+static DEM_ALWAYS_INLINE void prefetch_pair_state(const pair_ctx *restrict c, size_t k, size_t end, int hl)
 {
-    if (k + DEM_PREFETCH_AHEAD < end) prefetch_springs_at(c->hist + (k + DEM_PREFETCH_AHEAD) * (size_t)hl, hl);
+    if (k + DEM_PREFETCH_AHEAD >= end) return;
+    prefetch_springs_at(c->hist + (k + DEM_PREFETCH_AHEAD) * (size_t)hl, hl);
+    __builtin_prefetch(c->constants + k + DEM_PREFETCH_AHEAD, 0, 2);
 }
 
 // Touching pair k (i, j, separation d) into the batch, flushing it when full
@@ -802,7 +807,7 @@ static DEM_ALWAYS_INLINE void batch_pairs(dem_world *restrict w, const pair_ctx 
         int nt = 0, no = 0;
         for (size_t k = p0; k < p1; ++k) {
             prefetch_partner(c, k, k1);
-            prefetch_springs(c, k, k1, hl);
+            prefetch_pair_state(c, k, k1, hl);
             dem_vec3 d;
             const int x = nbr[k] >= hi, in = pair_touches(w, c, row[k], nbr[k], mask, &d) | x;
             take[nt] = k, sep[nt] = d, crossing[nt] = (unsigned char)x, open[no] = k;
