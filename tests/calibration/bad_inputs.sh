@@ -32,6 +32,12 @@ csv() { # csv NAME CONTENT: a config whose angle file is CONTENT
   sed "s|repose_angle: ../data/repose_angle.csv|repose_angle: ../data/$1.csv|" "$work/configs/good.yaml" > "$work/configs/$1.yaml"
   echo "$work/configs/$1.yaml"
 }
+csa() { # csa NAME CONTENT: a config whose occupied-area file is CONTENT
+  printf '%b' "$2" > "$work/data/$1.csv"
+  sed "s|occupied_area: ../experiments/data/occupied_area.csv|occupied_area: ../data/$1.csv|" "$src/configs/calibration.yaml" |
+    sed 's|\.\./experiments/data/|../data/|' > "$work/configs/$1.yaml"
+  echo "$work/configs/$1.yaml"
+}
 out=(--out "$work/out")
 expect "missing config" "nonexistent.yaml" -- "$work/configs/nonexistent.yaml" "${out[@]}"
 expect "negative friction" "pour_mu_s.yaml:" -- "$(edit pour_mu_s 's/^pour_mu_s: 0.5/pour_mu_s: -0.5/')" "${out[@]}"
@@ -51,6 +57,9 @@ expect "wrong columns" "cols.csv:1: header" -- "$(csv cols 'surface,rpm,angle\nP
 expect "NaN in CSV" "nan.csv:2: angle_deg" -- "$(csv nan 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,nan,0.5\n')" "${out[@]}"
 expect "negative rpm" "rpm.csv:2: rpm" -- "$(csv rpm 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,-4,31.9,0.5\n')" "${out[@]}"
 expect "truncated CSV" "trunc.csv:2: row" -- "$(csv trunc 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31')" "${out[@]}"
+# A row with more fields than its header (issue 26), in either file, on its first data row.
+expect "extra fields, angle file" "extra_angle.csv:2: row: has 7 fields, expected 4" -- "$(csv extra_angle 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5,1,2,3\nPP,4,32.2,0.5\n')" "${out[@]}"
+expect "extra fields, CSA file" "extra_csa.csv:3: row: has 7 fields, expected 4" -- "$(csa extra_csa '# lab\nsurface,rpm,csa_percent,csa_sd_percent\nPTFE,4,45,0.5,1,2,3\nPTFE,40,50,0.5\n')" "${out[@]}"
 expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
 expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
 [ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }

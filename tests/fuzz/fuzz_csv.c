@@ -5,7 +5,8 @@
 // is a valid measurement (what the loader promises its callers), or refuses
 // it with a non-empty message naming the file and leaves nothing allocated;
 // never a crash, a leak or undefined behaviour (ASan, UBSan). A file with a
-// NUL byte is not text: it must be refused.
+// NUL byte is not text: it must be refused, and so must a row whose field
+// count differs from the header's (issue 26).
 #include <math.h>
 #include <string.h>
 #include <strings.h>
@@ -39,7 +40,33 @@ static void check_accepted(const cal_series *s, cal_data_kind kind, const char *
     }
 }
 
-static void load(const char *path, cal_data_kind kind, int has_nul)
+/// Independent of libcsv: in a file without quotes every row is its commas
+/// plus one fields, so an accepted file must have exactly three commas on
+/// every line that is not blank or a '#' comment (the header included).
+/// Lines end at LF or at a lone CR, as libcsv ends its rows.
+static void check_field_counts(const uint8_t *data, size_t size)
+{
+    if (memchr(data, '"', size)) return;
+    size_t start = 0;
+    while (start < size) {
+        size_t end = start;
+        while (end < size && data[end] != '\n' && data[end] != '\r') end++;
+        size_t first = start;
+        while (first < end && (data[first] == ' ' || data[first] == '\t')) first++;
+        if (first < end && data[first] != '#') {
+            int commas = 0;
+            for (size_t k = first; k < end; ++k) commas += data[k] == ',';
+            if (commas != 3) {
+                char detail[96];
+                snprintf(detail, sizeof detail, "a row at byte %zu has %d fields", start, commas + 1);
+                fuzz_violation("cal_series_load accepted a row whose field count is not the header's 4", detail);
+            }
+        }
+        start = end + 1;
+    }
+}
+
+static void load(const uint8_t *data, size_t size, const char *path, cal_data_kind kind, int has_nul)
 {
     char err[2048];
     cal_series s;
@@ -48,6 +75,7 @@ static void load(const char *path, cal_data_kind kind, int has_nul)
         if (has_nul) fuzz_violation("cal_series_load accepted a file with a NUL byte", NULL);
         fuzz_report(kind == CAL_DATA_ANGLE ? "cal_series_load(angle)" : "cal_series_load(csa)", NULL);
         check_accepted(&s, kind, path);
+        check_field_counts(data, size);
         cal_series_free(&s);
         if (s.points || s.count) fuzz_violation("cal_series_free left points behind", NULL);
         return;
@@ -60,7 +88,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     const char *path = fuzz_write_temp(data, size);
     int has_nul = size > 0 && memchr(data, '\0', size) != NULL;
-    load(path, CAL_DATA_ANGLE, has_nul);
-    load(path, CAL_DATA_CSA, has_nul);
+    load(data, size, path, CAL_DATA_ANGLE, has_nul);
+    load(data, size, path, CAL_DATA_CSA, has_nul);
     return 0;
 }
