@@ -15,6 +15,8 @@
 
 #include <hdf5.h>
 
+#include "dem_h5_errors.h"
+
 // Vector arrays go to HDF5 as N×3 doubles straight from the view, no copy.
 _Static_assert(sizeof(dem_vec3) == 3 * sizeof(double), "dem_vec3 must be three packed doubles");
 
@@ -45,55 +47,11 @@ struct dem_h5_writer {
     frame_info *frame;
     size_t frame_count, frame_cap;
     int failed; // an HDF5 write failed: the file can no longer be trusted
-    char error[1024];
+    char error[2048];
 };
 
 // ---------------------------------------------------------------------------
 // Errors
-
-// HDF5's automatic printing goes to stderr from deep inside the library; we
-// report ourselves instead. Saved and restored so other HDF5 users in the
-// process (the result store) keep whatever handler they chose.
-typedef struct h5_quiet {
-    H5E_auto2_t func;
-    void *data;
-} h5_quiet;
-
-static h5_quiet quiet_begin(void)
-{
-    h5_quiet q = {NULL, NULL};
-    H5Eget_auto2(H5E_DEFAULT, &q.func, &q.data);
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    return q;
-}
-
-static void quiet_end(h5_quiet q) { H5Eset_auto2(H5E_DEFAULT, q.func, q.data); }
-
-typedef struct text_buf {
-    char *buf;
-    size_t len;
-} text_buf;
-
-// Walking upward, entry 0 is the innermost one: the most specific reason
-// (for a failed create it carries the file name and errno text).
-static herr_t innermost_error(unsigned n, const H5E_error2_t *e, void *ctx)
-{
-    text_buf *t = ctx;
-    if (n == 0 && e->desc)
-        snprintf(t->buf, t->len, "%s", e->desc);
-    return 0;
-}
-
-static void hdf5_reason(char *buf, size_t len)
-{
-    text_buf t = {buf, len};
-    buf[0] = '\0';
-    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, &t);
-    // Keep the message on one line (write failures embed a ctime() stamp).
-    for (char *c = buf; *c; c++)
-        if (*c == '\n' || *c == '\t')
-            *c = ' ';
-}
 
 static void put_message(char *err, size_t err_len, const char *msg)
 {
@@ -119,7 +77,7 @@ static void set_error(dem_h5_writer *w, const char *file, const char *reason, co
 static int fail_h5(dem_h5_writer *w, const char *fmt, ...)
 {
     char reason[512];
-    hdf5_reason(reason, sizeof reason);
+    dem_h5_reason(reason, sizeof reason);
     va_list ap;
     va_start(ap, fmt);
     set_error(w, w->h5_path, reason, fmt, ap);
@@ -466,11 +424,11 @@ dem_h5_writer *dem_h5_open(const char *h5_path, char *err, size_t err_len)
             snprintf(err, err_len, "'%s': out of memory", h5_path);
         return NULL;
     }
-    h5_quiet q = quiet_begin();
+    dem_h5_quiet q = dem_h5_quiet_begin();
     int rc = create_file(w);
     if (rc)
         discard(w);
-    quiet_end(q);
+    dem_h5_quiet_end(q);
     if (rc) {
         put_message(err, err_len, w->error);
         writer_free(w);
@@ -528,9 +486,9 @@ int dem_h5_write_frame(dem_h5_writer *w, double time, const dem_granules_view *g
         return -1; // keep the first message: it names the real cause
     if (check_frame_args(w, g, d) || reserve_frame(w))
         return -1;
-    h5_quiet q = quiet_begin();
+    dem_h5_quiet q = dem_h5_quiet_begin();
     int rc = write_frame(w, time, g, d);
-    quiet_end(q);
+    dem_h5_quiet_end(q);
     if (rc)
         return rc;
     w->frame[w->frame_count++] = (frame_info){time, g->count};
@@ -545,7 +503,7 @@ int dem_h5_write_attribute_string(dem_h5_writer *w, const char *name, const char
         return -1;
     if (!name || !name[0] || !value)
         return fail_arg(w, "root attribute: name and value are required");
-    h5_quiet q = quiet_begin();
+    dem_h5_quiet q = dem_h5_quiet_begin();
     int rc = 0;
     // Setting a name again replaces it (H5Acreate2 refuses an existing name).
     htri_t exists = H5Aexists(w->file, name);
@@ -555,7 +513,7 @@ int dem_h5_write_attribute_string(dem_h5_writer *w, const char *name, const char
         rc = fail_h5(w, "cannot replace root attribute %s", name);
     if (rc == 0)
         rc = write_string_attribute(w, w->file, "/", name, value);
-    quiet_end(q);
+    dem_h5_quiet_end(q);
     return rc;
 }
 
@@ -681,13 +639,13 @@ int dem_h5_close(dem_h5_writer *w, char *err, size_t err_len)
 {
     if (!w)
         return 0;
-    h5_quiet q = quiet_begin();
+    dem_h5_quiet q = dem_h5_quiet_begin();
     int rc = finish(w);
     if (rc) {
         discard(w);
         put_message(err, err_len, w->error);
     }
-    quiet_end(q);
+    dem_h5_quiet_end(q);
     writer_free(w);
     return rc;
 }
