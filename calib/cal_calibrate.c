@@ -53,10 +53,14 @@ static const char help[] =
     "  --material NAME    fit this wall material only (implies --stage wall)\n"
     "  --out DIR          results folder (default results/<config>-<tier>)\n"
     "  --jobs N           simulations side by side on this machine (default: cores)\n"
+    "  --checkpoint-every S  wall seconds between a drum run's checkpoints (default 120;\n"
+    "                     0: none)\n"
     "  -h, --help         this text\n"
     "\n"
     "Resuming: every simulation is stored in OUT/store under a hash of everything that\n"
     "defines it; run the same command again after a kill and nothing finished is rerun.\n"
+    "A drum run killed while turning resumes from its last checkpoint (OUT/store/*.turn.h5)\n"
+    "and ends as it would have uninterrupted (bit for bit; its bed is settled again).\n"
     "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
     "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
     "\n"
@@ -68,14 +72,15 @@ static const char help[] =
 typedef struct options {
     const char *config, *tier, *stage, *material, *out;
     int jobs;
+    double checkpoint_every_s;
 } options;
 
 static int parse_options(int argc, char **argv, options *o)
 {
     static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
                                           {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
-                                          {0, 0, 0, 0}};
-    *o = (options){.config = "configs/calibration.yaml", .stage = "all"};
+                                          {"checkpoint-every", 1, 0, 'c'}, {0, 0, 0, 0}};
+    *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     o->jobs = ncpu > 0 ? (int)ncpu : 1;
     int c;
@@ -91,6 +96,9 @@ static int parse_options(int argc, char **argv, options *o)
             if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024))
                 return fprintf(stderr, "granucal calibrate: --jobs '%s': expected a whole number in 1..1024\n", optarg), 2;
             o->jobs = (int)v;
+            break;
+        case 'c':
+            if (cal_parse_checkpoint_every("calibrate", optarg, &o->checkpoint_every_s)) return 2;
             break;
         case 'h': fputs(help, stdout); return -1;
         default: fputs("\n", stderr), fputs(help, stderr); return 2;
@@ -354,6 +362,7 @@ int cal_cmd_calibrate(int argc, char **argv)
     if (!status) {
         snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
         r->env.workers = r->opt.jobs, r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2);
+        r->env.checkpoint_every_s = r->opt.checkpoint_every_s;
         status = calibrate(r, command);
     }
     if (status) fprintf(stderr, "granucal calibrate: %s\n", r->err);

@@ -184,6 +184,24 @@ static int killed_from_outside(int sig)
     return sig == SIGKILL || sig == SIGTERM || sig == SIGINT || sig == SIGHUP || sig == SIGQUIT;
 }
 
+int cal_parse_checkpoint_every(const char *command, const char *text, double *out)
+{
+    double v;
+    if (exp_parse_number(text, &v) || !(v >= 0 && v <= 86400))
+        return fprintf(stderr, "granucal %s: --checkpoint-every '%s': expected wall seconds in [0, 86400]\n", command,
+                       text), 2;
+    *out = v;
+    return 0;
+}
+
+// A drum run's checkpoint: beside its record, named by the same hash.
+static void checkpoint_path(const cal_env *env, const char *key, char *out, size_t len)
+{
+    char hash[17];
+    cal_store_hash(key, hash);
+    snprintf(out, len, "%s/%s.turn.h5", env->store, hash);
+}
+
 // Turn `bed` at run r's speed and store the record; fill_s: the settling's
 // wall time, charged to this run. The bed itself is turned only when it is
 // this run's alone (a forked child's copy, own = 1); else a clone.
@@ -195,22 +213,32 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     run.rpm = b->rpm[r.k];
     dem_world *w = own ? bed : dem_world_clone(bed);
     if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
+    char ck_path[1300], ck_tmp[1310];
+    checkpoint_path(b->env, key, ck_path, sizeof ck_path);
+    snprintf(ck_tmp, sizeof ck_tmp, "%s.tmp", ck_path);
+    exp_drum_checkpoint ck = {ck_path, key, b->env->checkpoint_every_s};
+    if (ck.every_s > 0) run.checkpoint = &ck;
     double t0 = exp_wall_seconds();
     exp_drum_result res;
     dem_status st = exp_drum_rotate(w, &c->def, &run, NULL, NULL, &res);
+    if (res.checkpoint_note[0]) fprintf(stderr, "[%s] %s\n", b->env->stage, res.checkpoint_note);
+    if (res.resumed)
+        fprintf(stderr, "[%s] %g rpm: resumed from its checkpoint (%.0f s of wall time saved)\n", b->env->stage,
+                run.rpm, res.earlier_wall_s);
     cal_record rec = {.key = (char *)key, .reason = ""};
     rec.status = st != DEM_OK ? "failed" : res.steady ? "ok" : "not steady";
     if (st != DEM_OK) rec.reason = (char *)dem_world_error(w);
     rec.angle_deg = res.angle_deg, rec.angle_sd_deg = res.angle_sd_deg;
     rec.csa_percent = res.csa_percent, rec.csa_sd_percent = res.csa_sd_percent;
     rec.steady = res.steady, rec.simulated_time_s = res.simulated_time_s;
-    rec.wall_time_s = exp_wall_seconds() - t0;
+    rec.wall_time_s = exp_wall_seconds() - t0 + res.earlier_wall_s;
     rec.fill_wall_time_s = fill_s;
     rec.peak_rss_mb = exp_peak_rss_mb();
     rec.dt_s = dem_world_dt(w), rec.particle_steps = (double)res.particle_steps, rec.granules = (int)res.granules;
     char err[512];
     int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
+    else remove(ck_path), remove(ck_tmp); // the record holds the result now
     if (!own) dem_world_destroy(w);
     return bad;
 }

@@ -22,8 +22,19 @@ typedef struct cal_env {
     int tty;            ///< progress on a terminal
     const char *stage;  ///< label of the current stage, for progress lines
     double started;     ///< wall clock at the start of the calibration
+    /// Wall seconds between a drum run's checkpoints in the store (0: none):
+    /// a killed run, run again, resumes its turn from the last one.
+    double checkpoint_every_s;
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
 } cal_env;
+
+/// Default wall seconds between a drum run's checkpoints: a kill costs at
+/// most this much turning, and a save (a few MB at λ 1000) is a small share.
+#define CAL_CHECKPOINT_EVERY_S 120.0
+
+/// Parse a --checkpoint-every value (wall seconds, 0 = never, at most a day)
+/// into *out; 0, or 2 after a message naming the command and the value.
+int cal_parse_checkpoint_every(const char *command, const char *text, double *out);
 
 /// A drum candidate: the drum and powder, how its bed is settled, and how
 /// each speed is run.

@@ -47,6 +47,8 @@ static const char help[] =
     "  --seeds N            replaces fidelity.seeds (1-16)\n"
     "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
     "  --jobs N             simulations side by side (default: cores)\n"
+    "  --checkpoint-every S wall seconds between a drum run's checkpoints (default 120;\n"
+    "                       0: none); a killed study, run again, resumes each turn\n"
     "  -h, --help           this text\n"
     "\n"
     "Outputs in DIR: fidelity.csv (rung x speed), fidelity_summary.csv (rung),\n"
@@ -62,7 +64,7 @@ static const struct {
 
 typedef struct options {
     const char *config, *out, *rungs;
-    double budget_hours;
+    double budget_hours, checkpoint_every_s;
     int jobs, seeds; ///< seeds 0: the config's
 } options;
 
@@ -94,9 +96,9 @@ static int parse_options(int argc, char **argv, options *o)
     static const struct option longs[] = {{"out", required_argument, 0, 'o'}, {"budget-hours", required_argument, 0, 'b'},
                                           {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
                                           {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
-                                          {0, 0, 0, 0}};
+                                          {"checkpoint-every", required_argument, 0, 'c'}, {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
-                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
+                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     optind = 1;
     for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
         double v = NAN;
@@ -116,6 +118,9 @@ static int parse_options(int argc, char **argv, options *o)
             if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 16))
                 return fprintf(stderr, "granucal study: --seeds '%s': need an integer in [1, 16]\n", optarg), 2;
             o->seeds = (int)v;
+            break;
+        case 'c':
+            if (cal_parse_checkpoint_every("study", optarg, &o->checkpoint_every_s)) return 2;
             break;
         case 'h': fputs(help, stdout); return -1;
         default: fputs(help, stderr); return 2;
@@ -464,6 +469,7 @@ int cal_cmd_study(int argc, char **argv)
     if (!status) {
         snprintf(s->env.store, sizeof s->env.store, "%s/store", s->out);
         s->env.workers = s->opt.jobs, s->env.use_fork = cal_mpi_size() == 1, s->env.tty = isatty(2);
+        s->env.checkpoint_every_s = s->opt.checkpoint_every_s;
         s->env.started = t0;
         status = run_ladder(s);
     }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_checkpoint.h"
 #include "dem_scaling.h"
 #include "exp_pour.h"
 
@@ -255,10 +256,53 @@ static int is_steady(const exp_drum_measure *m, int count, int per_window, const
     return fabs(a.mean_angle - b.mean_angle) <= angle_tol && fabs(a.mean_csa - b.mean_csa) <= csa_tol;
 }
 
-dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
-                           void *ctx, exp_drum_result *out)
+// Everything of a rotation run that is not the world: what a checkpoint
+// saves beside it.
+typedef struct turn_state {
+    exp_drum_measure *m; // one per sample
+    int count, cap;
+    uint64_t steps;
+    double t0, earlier_wall_s;
+} turn_state;
+
+enum { MEASURE_DOUBLES = 4, TURN_DOUBLES = 4 };
+_Static_assert(sizeof(exp_drum_measure) == MEASURE_DOUBLES * sizeof(double), "a measurement is saved as 4 doubles");
+
+static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_state *s, double wall_s, char *err,
+                     size_t len)
 {
-    memset(out, 0, sizeof *out);
+    double turn[TURN_DOUBLES] = {s->t0, (double)s->steps, s->earlier_wall_s + wall_s, o->start_tilt_deg};
+    dem_checkpoint_array extra[2] = {{"turn", turn, TURN_DOUBLES},
+                                     {"measurements", (double *)s->m, (size_t)s->count * MEASURE_DOUBLES}};
+    return dem_checkpoint_write(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, len);
+}
+
+// 1 if the run's checkpoint was there and now holds w and s; else 0, with
+// a note if a checkpoint was there but could not be resumed.
+static int resume_turn(dem_world *w, const exp_drum_run_opts *o, turn_state *s, exp_drum_result *out)
+{
+    dem_checkpoint_array extra[2] = {{"turn", NULL, 0}, {"measurements", NULL, 0}};
+    char err[400];
+    int rc = dem_checkpoint_read(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, sizeof err);
+    int ok = rc == 0 && extra[0].count == TURN_DOUBLES && extra[1].count % MEASURE_DOUBLES == 0 &&
+             extra[1].count / MEASURE_DOUBLES <= (size_t)s->cap;
+    if (ok) {
+        s->t0 = extra[0].data[0], s->steps = (uint64_t)extra[0].data[1], s->earlier_wall_s = extra[0].data[2];
+        out->start_tilt_deg = extra[0].data[3];
+        s->count = (int)(extra[1].count / MEASURE_DOUBLES);
+        memcpy(s->m, extra[1].data, extra[1].count * sizeof(double));
+    } else if (rc != 1)
+        snprintf(out->checkpoint_note, sizeof out->checkpoint_note, "%s; the run starts afresh",
+                 rc == 0 ? "checkpoint of another length of run" : err);
+    free(extra[0].data), free(extra[1].data);
+    return ok;
+}
+
+// A run not resumed: the turn's own contacts, the start tilt, the step the
+// bed allows, and the drum set turning.
+static dem_status start_turn(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, turn_state *s,
+                             exp_drum_result *out)
+{
     // The turn's own friction: a bed may have been settled with another pair
     // (a calibration's wall stage settles one bed for all its candidates).
     dem_contact_params granule = dem_scale_contact(&d->granule, d->lambda), wall = dem_scale_contact(&d->wall, d->lambda),
@@ -274,31 +318,51 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     // The end plates are part of the drum and turn with it (walls 1 and 2
     // of a full drum; they stood still before, dragging the bed's faces).
     for (int k = 0; k < (d->periodic ? 1 : 3); ++k) dem_world_set_wall_spin(w, k, o->rpm * 2.0 * DEM_PI / 60.0);
-    int per_window = (int)(o->window / o->sample_interval + 0.5), cap = (int)(o->max_time / o->sample_interval) + 2;
-    exp_drum_measure *m = malloc((size_t)cap * sizeof *m);
-    if (!m) return DEM_ERR_NOMEM;
-    uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5), steps = 0;
-    double t0 = dem_world_time(w), pixel = face_pixel(d);
-    int count = 0;
-    while (count < cap && dem_world_time(w) - t0 < o->max_time - 0.5 * o->sample_interval && !out->steady) {
+    s->t0 = dem_world_time(w);
+    return DEM_OK;
+}
+
+dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
+                           void *ctx, exp_drum_result *out)
+{
+    memset(out, 0, sizeof *out);
+    int per_window = (int)(o->window / o->sample_interval + 0.5);
+    turn_state s = {.cap = (int)(o->max_time / o->sample_interval) + 2};
+    s.m = malloc((size_t)s.cap * sizeof *s.m);
+    if (!s.m) return DEM_ERR_NOMEM;
+    out->resumed = o->checkpoint && resume_turn(w, o, &s, out);
+    dem_status st = out->resumed ? DEM_OK : start_turn(w, d, o, &s, out);
+    if (st != DEM_OK) return free(s.m), st;
+    out->earlier_wall_s = s.earlier_wall_s;
+    uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
+    double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
+    out->steady = is_steady(s.m, s.count, per_window, o);
+    while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval && !out->steady) {
         st = dem_world_step(w, chunk);
-        steps += chunk;
-        if (st != DEM_OK || exp_drum_measure_now(w, d, pixel, d->closing_px, &m[count])) break;
-        count++;
-        out->steady = is_steady(m, count, per_window, o);
-        if (progress) progress("turn", dem_world_time(w) - t0, dem_world_granules(w).count, ctx);
+        s.steps += chunk;
+        if (st != DEM_OK || exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count])) break;
+        s.count++;
+        out->steady = is_steady(s.m, s.count, per_window, o);
+        if (progress) progress("turn", dem_world_time(w) - s.t0, dem_world_granules(w).count, ctx);
+        double now = exp_wall_seconds();
+        if (o->checkpoint && now - saved >= o->checkpoint->every_s) {
+            // A checkpoint that cannot be written costs the resume, not the run.
+            if (save_turn(w, o, &s, now - started, out->checkpoint_note, sizeof out->checkpoint_note) == 0)
+                out->checkpoint_note[0] = '\0';
+            saved = now;
+        }
     }
     // The two windows the steady test compared are one state: both are
     // averaged (a slumping bed's saw-tooth makes one window's mean depend on
     // where in an avalanche cycle it starts).
-    int from = count > 2 * per_window ? count - 2 * per_window : 0;
-    window_stats s = count ? stats_of(m, from, count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
-    free(m);
-    out->angle_deg = s.mean_angle, out->angle_sd_deg = s.sd_angle;
-    out->csa_percent = s.mean_csa, out->csa_sd_percent = s.sd_csa, out->fit_sd_m = s.mean_fit;
-    out->simulated_time_s = dem_world_time(w) - t0;
+    int from = s.count > 2 * per_window ? s.count - 2 * per_window : 0;
+    window_stats ws = s.count ? stats_of(s.m, from, s.count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
+    free(s.m);
+    out->angle_deg = ws.mean_angle, out->angle_sd_deg = ws.sd_angle;
+    out->csa_percent = ws.mean_csa, out->csa_sd_percent = ws.sd_csa, out->fit_sd_m = ws.mean_fit;
+    out->simulated_time_s = dem_world_time(w) - s.t0;
     out->granules = dem_world_granules(w).count;
-    out->particle_steps = (unsigned long long)steps * out->granules;
+    out->particle_steps = (unsigned long long)s.steps * out->granules;
     if (st != DEM_OK) out->steady = 0;
     return st;
 }

@@ -60,6 +60,15 @@ typedef struct exp_drum_measure {
 int exp_drum_measure_now(const dem_world *w, const exp_drum_def *d, double pixel, int closing_px,
                          exp_drum_measure *out);
 
+/// Where a rotation run saves its state, so that a killed run resumes
+/// instead of starting over (dem_checkpoint.h: bit for bit, same build and
+/// thread count).
+typedef struct exp_drum_checkpoint {
+    const char *path; ///< the run's checkpoint file
+    const char *key;  ///< the text that defines the run: another run's checkpoint is not resumed
+    double every_s;   ///< wall seconds between saves, each at the end of a sample
+} exp_drum_checkpoint;
+
 /// How a rotation run decides it is done.
 typedef struct exp_drum_run_opts {
     double rpm;
@@ -74,6 +83,9 @@ typedef struct exp_drum_run_opts {
     /// which a real drum does before it avalanches. Saves the rigid turn a
     /// level bed needs before its first avalanche (0.8 s of 6 s at 4 rpm).
     double start_tilt_deg;
+    /// NULL: no checkpoints. Not part of what defines a run: a run resumed
+    /// from its checkpoints ends as the same run uninterrupted would.
+    const exp_drum_checkpoint *checkpoint;
 } exp_drum_run_opts;
 
 exp_drum_run_opts exp_default_drum_run_opts(void);
@@ -90,6 +102,11 @@ typedef struct exp_drum_result {
     double start_tilt_deg;  ///< the start tilt the bed was turned by (exp_drum_run_opts)
     int steady;             ///< 1 if the window criterion held before max_time
     double simulated_time_s, wall_time_s;
+    /// Wall seconds the run had cost before the checkpoint it resumed from
+    /// (0: not resumed); a caller timing the run adds them to its own clock.
+    double earlier_wall_s;
+    int resumed;                 ///< 1: resumed from a checkpoint
+    char checkpoint_note[512];   ///< why a checkpoint found was not resumed, else ""
     unsigned long long particle_steps;
     size_t granules;
 } exp_drum_result;
@@ -97,8 +114,13 @@ typedef struct exp_drum_result {
 /// Turn a filled drum at opts->rpm until statistically steady (two
 /// consecutive windows agree) or max_time; the world is changed. The contact
 /// pairs of @p d are applied first, so a bed settled with other friction
-/// turns with these. Returns
-/// the engine status; a fault is recorded in the result as not steady.
+/// turns with these. With opts->checkpoint, the run first resumes from its
+/// checkpoint if one is there (the world's whole state is then replaced by
+/// the checkpoint's, and the bed given is not used); one that cannot be
+/// resumed is said in the result's checkpoint_note and the run starts afresh. The state is saved every checkpoint->every_s of
+/// wall time; the file is left in place (the caller removes it once the
+/// result is safe). Returns the engine status; a fault is recorded in the
+/// result as not steady.
 dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
                            void *ctx, exp_drum_result *out);
 
