@@ -11,6 +11,7 @@ int cal_cmd_study(int argc, char **argv);
 
 /// Run a drum experiment config with `--set` overrides, at the config's rpm or
 /// at each of `rpm_list` ("4,40,80") from one settled bed; results in `out`.
-int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list);
+int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list,
+                      double checkpoint_every_s);
 
 #endif

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cal_commands.h"
+#include "cal_sim.h"
 #include "cal_util.h"
 #include "exp_common.h"
 #include "dem_output.h"
@@ -84,7 +85,7 @@ static int parse_rpm_list(const char *list, double *rpm, int cap, char *err, siz
 // Turn one copy of the settled bed at `rpm`; results in DIR (a sweep: in
 // DIR/rpm_<rpm>/).
 static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def *def, exp_drum_run_opts run, double rpm,
-                     const char *dir, int sweep, progress_state *p, FILE *json_out, int first)
+                     const char *dir, int sweep, progress_state *p, FILE *json_out, int first, double checkpoint_every_s)
 {
     char sub[1100], err[1024];
     if (sweep) snprintf(sub, sizeof sub, "%s/rpm_%g", dir, rpm);
@@ -96,21 +97,33 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
         return 1;
     }
     run.rpm = y->rpm = rpm;
+    // The run's checkpoint, labelled with what defines it (as a calibration's record).
+    char key[2048], ck_path[1200], ck_tmp[1210];
+    cal_drum_case whole = {*def, *def, run};
+    cal_drum_key(&whole, rpm, key, sizeof key);
+    snprintf(ck_path, sizeof ck_path, "%s/checkpoint.h5", sub);
+    snprintf(ck_tmp, sizeof ck_tmp, "%s.tmp", ck_path);
+    exp_drum_checkpoint ck = {ck_path, key, checkpoint_every_s};
+    if (checkpoint_every_s > 0) run.checkpoint = &ck;
     double t0 = exp_wall_seconds();
     exp_drum_result r;
     dem_status st = exp_drum_rotate(w, def, &run, show_progress, p, &r);
-    r.wall_time_s = exp_wall_seconds() - t0;
+    r.wall_time_s = exp_wall_seconds() - t0 + r.earlier_wall_s;
     if (p->tty) fputc('\n', stderr);
+    if (r.checkpoint_note[0]) fprintf(stderr, "granucal simulate: %s\n", r.checkpoint_note);
+    if (r.resumed) fprintf(stderr, "granucal simulate: %g rpm resumed from %s\n", rpm, ck_path);
     const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: %g rpm: %s\n", rpm, dem_world_error(w));
     int bad = save(sub, y, &r, w, status);
+    if (!bad) remove(ck_path), remove(ck_tmp); // result.json holds the result now
     if (!first) fputs(", ", json_out);
     write_json(json_out, y, &r, w, status);
     dem_world_destroy(w);
     return bad || st != DEM_OK;
 }
 
-int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list)
+int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list,
+                      double checkpoint_every_s)
 {
     char err[1024], dir[1024];
     double rpms[32];
@@ -131,7 +144,8 @@ int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out
             dem_world_granules(bed).count, dem_world_time(bed), dem_world_dt_report(bed));
     int bad = 0;
     if (n_rpm > 1) fputs("{\"experiment\": \"drum speed sweep\", \"runs\": [", stdout);
-    for (int k = 0; k < n_rpm; ++k) bad |= turn_copy(bed, y, &def, run, rpms[k], dir, n_rpm > 1, &p, stdout, k == 0);
+    for (int k = 0; k < n_rpm; ++k)
+        bad |= turn_copy(bed, y, &def, run, rpms[k], dir, n_rpm > 1, &p, stdout, k == 0, checkpoint_every_s);
     if (n_rpm > 1) fputs("]}\n", stdout);
     dem_world_destroy(bed);
     exp_drum_config_free(y);

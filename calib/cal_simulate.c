@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cal_commands.h"
+#include "cal_sim.h"
 #include "cal_util.h"
 #include "exp_common.h"
 #include "dem_output.h"
@@ -18,6 +19,7 @@
 
 static const char simulate_help[] =
     "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"
+    "                         [--checkpoint-every S]\n"
     "\n"
     "A drum experiment (a file that starts `experiment: drum`, e.g. configs/drum.yaml):\n"
     "fills the drum by bed volume, turns the settled bed rigidly by start_tilt_deg\n"
@@ -29,7 +31,10 @@ static const char simulate_help[] =
     "--set overrides a field: rpm, mu_s, mu_r, k_n, xi, wall (granules or a material),\n"
     "lambda, seed, fill, slice_depth, max_time, start_tilt_deg. --rpm-list\n"
     "4,40,80,105,116 turns one settled bed at each speed (results in\n"
-    "DIR/rpm_<speed>/, one JSON with \"runs\").\n"
+    "DIR/rpm_<speed>/, one JSON with \"runs\"). Each turn saves its state to\n"
+    "DIR[/rpm_<speed>]/checkpoint.h5 every --checkpoint-every S of wall time (default\n"
+    "120, 0: never); the same command after a kill resumes the turn there (the bed is\n"
+    "settled again) and ends as the uninterrupted run would, bit for bit.\n"
     "Examples:\n"
     "  granucal simulate configs/drum.yaml --set rpm=40 --set wall=PTFE\n"
     "  granucal simulate configs/drum.yaml --rpm-list 4,40,80,105,116\n"
@@ -158,8 +163,10 @@ int cal_cmd_simulate(int argc, char **argv)
 {
     static const struct option opts[] = {{"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'},
                                          {"rpm-list", required_argument, 0, 'r'},
+                                         {"checkpoint-every", required_argument, 0, 'c'},
                                          {"help", no_argument, 0, 'h'}, {0}};
     const char *out = NULL, *rpm_list = NULL;
+    double checkpoint_every_s = CAL_CHECKPOINT_EVERY_S;
     char *sets[64];
     int n_sets = 0, c;
     while ((c = getopt_long(argc, argv, "o:s:h", opts, NULL)) != -1) {
@@ -167,10 +174,12 @@ int cal_cmd_simulate(int argc, char **argv)
         if (c == 'o') out = optarg;
         else if (c == 's' && n_sets < 64) sets[n_sets++] = optarg;
         else if (c == 'r') rpm_list = optarg;
-        else return fputs(simulate_help, stderr), 2;
+        else if (c == 'c') {
+            if (cal_parse_checkpoint_every("simulate", optarg, &checkpoint_every_s)) return 2;
+        } else return fputs(simulate_help, stderr), 2;
     }
     if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
-    if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out, rpm_list);
+    if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out, rpm_list, checkpoint_every_s);
     if (exp_is_compress_config(argv[optind])) return exp_compress_simulate(argv[optind], n_sets, sets, out);
     if (exp_is_silo_config(argv[optind])) return exp_silo_simulate(argv[optind], n_sets, sets, out);
     if (exp_is_cylinder_config(argv[optind])) return exp_cylinder_simulate(argv[optind], n_sets, sets, out);
