@@ -81,6 +81,9 @@ static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
              exp_results_version(), d->diameter, d->depth, d->periodic, d->fill, d->lambda, d->density, d->gsd.median_diameter,
              d->gsd.geometric_sd, d->gsd.truncation_sigmas, gg, wall, d->periodic ? "none" : plate, d->pixel,
              d->closing_px, (unsigned long long)d->seed);
+    // Named only when not the pour, so that the stores of every pour run keep their keys.
+    if (d->fill_method != EXP_FILL_POUR)
+        snprintf(out + strlen(out), len - strlen(out), " fill_method=%s", exp_drum_fill_method_name(d->fill_method));
 }
 
 void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)

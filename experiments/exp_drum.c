@@ -91,13 +91,47 @@ static int inside_drum(dem_vec3 p, const void *ctx)
     return p.x * p.x + p.y * p.y <= inner * inner;
 }
 
-static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *diam, size_t next, size_t n, double pitch)
+int exp_drum_fill_method_from_name(const char *name, exp_drum_fill_method *out)
+{
+    if (strcmp(name, "pour") == 0) return *out = EXP_FILL_POUR, 0;
+    if (strcmp(name, "pack") == 0) return *out = EXP_FILL_PACK, 0;
+    return 1;
+}
+
+const char *exp_drum_fill_method_name(exp_drum_fill_method m) { return m == EXP_FILL_PACK ? "pack" : "pour"; }
+
+// Height (from the axis) below which the drum's cross-section holds the
+// fraction `fill` of its area: the level of a bed of that fill degree.
+static double fill_level(double r, double fill)
+{
+    double lo = -r, hi = r;
+    for (int it = 0; it < 60; ++it) {
+        double y = 0.5 * (lo + hi), above = r * r * acos(y / r) - y * sqrt(r * r - y * y);
+        if (1.0 - above / (DEM_PI * r * r) < fill) lo = y;
+        else hi = y;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// A random packing band reaches this far above the fill level, as a share
+// of the height still to fill: at a solid fraction of ~0.3 it settles to
+// about half its height, so a band 1.6 times the height left lands a little
+// short of the level and the next band tops it up.
+#define PACK_BAND_FACTOR 1.6
+#define PACK_TRIES 200 // random points a granule may try before the band counts as full
+
+static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *diam, size_t next, size_t n, double pitch,
+                          int layer)
 {
     double r = 0.5 * d->diameter, inner = r - 0.55 * pitch;
-    double margin = d->periodic ? 0.5 * pitch : 0.6 * pitch;
+    double margin = d->periodic ? 0.5 * pitch : 0.6 * pitch, density = dem_scale_density(d->density, d->lambda);
     exp_pour_region region = {dem_v3(-inner, -r, margin), dem_v3(inner, inner, d->depth - margin + 1e-12), inside_drum,
                               &inner};
-    return exp_pour_layer(w, &region, -r, diam, next, n, pitch, dem_scale_density(d->density, d->lambda));
+    if (d->fill_method == EXP_FILL_POUR) return exp_pour_layer(w, &region, -r, diam, next, n, pitch, density);
+    double level = fill_level(r, d->fill), surface = exp_bed_surface(w, -r);
+    double top = fmin(level + PACK_BAND_FACTOR * fmax(level - surface, pitch), inner);
+    return exp_pack_band(w, &region, -r, top, diam, next, n, density, d->seed * 1000003ULL + (unsigned long long)layer,
+                         PACK_TRIES);
 }
 
 // Raster resolution of the drum face: a quarter of the median diameter, and
@@ -169,8 +203,8 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     if (!w) return free(diam), NULL; // create_drum wrote the message
     if (dem_gsd_sample(&gsd, d->seed, cap, diam)) return fill_failed(w, diam, err, len, "cannot sample sizes");
     double pitch = 1.05 * dem_gsd_max_diameter(&gsd), target = 100.0 * d->fill;
-    for (size_t next = 0; csa_below(w, d, r) < target;) {
-        size_t placed = next < cap ? place_layer(w, d, diam, next, cap, pitch) : 0;
+    for (size_t next = 0, layer = 0; csa_below(w, d, r) < target; ++layer) {
+        size_t placed = next < cap ? place_layer(w, d, diam, next, cap, pitch, (int)layer) : 0;
         if (placed == 0) return fill_failed(w, diam, err, len, "no room left to pour: the fill degree is too high");
         if (dem_world_prepare(w) != DEM_OK ||
             exp_run_until_rest(w, gsd.median_diameter, LAYER_KE_RATIO, LAYER_MAX_TIME, CHECK_EVERY, progress, ctx, "pour"))

@@ -14,6 +14,20 @@
 #include "exp_common.h"
 #include "exp_measure.h"
 
+/// How exp_drum_fill builds the bed before it is cut to the fill degree.
+typedef enum exp_drum_fill_method {
+    /// Layers on a lattice one largest diameter apart, above the bed, each
+    /// landing before the next (the lab's pour, slowly).
+    EXP_FILL_POUR = 0,
+    /// Bands of a loose random packing (exp_pack_band) from the bed surface
+    /// to a little above the fill height, each settling before the next.
+    EXP_FILL_PACK = 1,
+} exp_drum_fill_method;
+
+/// "pour" or "pack" into *out; 0, or 1 for another name.
+int exp_drum_fill_method_from_name(const char *name, exp_drum_fill_method *out);
+const char *exp_drum_fill_method_name(exp_drum_fill_method m);
+
 /// Definition of a drum run. Powder and contacts are given for the REAL
 /// powder; the coarse-graining laws (eq. 15–18, engine/dem_scaling.c) are
 /// applied with `lambda` when the world is built.
@@ -31,6 +45,7 @@ typedef struct exp_drum_def {
     double pixel;               ///< raster pixel of the drum face, m; 0 = a quarter of the scaled d50
     int closing_px;             ///< closing radius in pixels (2: half a median diameter)
     uint64_t seed;
+    exp_drum_fill_method fill_method; ///< how the bed is built (EXP_FILL_POUR)
 } exp_drum_def;
 
 /// Defaults: the paper's drum and powder, Table 3, λ = 64, a periodic

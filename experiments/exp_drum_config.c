@@ -32,6 +32,7 @@ static const cyaml_schema_field_t drum_fields[] = {
     REQ_FLOAT("lambda", lambda), REQ_FLOAT("k_n", k_n), REQ_FLOAT("xi", xi), REQ_FLOAT("mu_s", mu_s),
     REQ_FLOAT("mu_r", mu_r),
     CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, damping, 1, 32),
+    CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, fill_method, 1, 16),
     CYAML_FIELD_STRING_PTR("wall", CYAML_FLAG_POINTER, exp_drum_yaml, wall, 1, 31),
     CYAML_FIELD_SEQUENCE("materials", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, materials,
                          &material_entry, 0, 16),
@@ -59,11 +60,12 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
     char key[32];
     const char *value = NULL;
     if (exp_split_set(set, key, &value, err, len)) return 1;
-    if (strcmp(key, "wall") == 0) {
+    char **text = strcmp(key, "wall") == 0 ? &y->wall : strcmp(key, "fill_method") == 0 ? &y->fill_method : NULL;
+    if (text) {
         char *copy = dup_string(value);
         if (!copy) return exp_fail(err, len, "out of memory");
-        free(y->wall);
-        y->wall = copy;
+        free(*text);
+        *text = copy;
         return 0;
     }
     struct { const char *name; double *field; } numbers[] = {
@@ -90,7 +92,7 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         return 0;
     }
     return exp_fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
-                          "slice_depth, max_time, start_tilt_deg)", key);
+                          "slice_depth, max_time, start_tilt_deg, fill_method)", key);
 }
 
 static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char *name)
@@ -131,6 +133,8 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
         def->wall.mu_s = m->mu_s, def->wall.mu_r = m->mu_r;
     }
     def->end_plate = def->wall;
+    if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &def->fill_method))
+        return exp_fail(err, len, "fill_method = '%s': use pour or pack", y->fill_method);
     if (y->pixel > 0) def->pixel = y->pixel;
     if (y->closing_px > 0) def->closing_px = y->closing_px;
     run->rpm = y->rpm, run->max_time = y->max_time;

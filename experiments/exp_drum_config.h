@@ -25,6 +25,7 @@ typedef struct exp_drum_yaml {
     double k_n;           ///< real granule stiffness, k_n = k_s = k_r (section 3.2)
     double xi, mu_s, mu_r;
     char *damping;
+    char *fill_method;    ///< optional: "pour" (default) or "pack" (exp_drum_fill_method)
     char *wall;           ///< lining material: "granules" or a name in materials
     exp_material_yaml *materials;
     unsigned materials_count;

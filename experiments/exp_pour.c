@@ -5,6 +5,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include <gsl/gsl_rng.h>
+
 #include "dem_vec.h"
 
 static int cmp_double(const void *a, const void *b)
@@ -57,6 +59,104 @@ size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_
                 if (dem_world_add_granule(w, p, v, dem_v3(0, 0, 0), 0.5 * diam[k], density) < 0) return placed;
                 placed++;
             }
+    return placed;
+}
+
+// Spheres already in a band, in a uniform grid of cells one largest
+// diameter wide, for the overlap test of random sequential addition.
+typedef struct band_grid {
+    dem_vec3 lo;
+    double cell;
+    int nx, ny, nz;
+    int *head, *next; // per cell: first sphere; per sphere: the next in its cell (-1 ends)
+    dem_vec3 *p;
+    double *r;
+    size_t count, cap;
+} band_grid;
+
+static int cell_of(const band_grid *g, dem_vec3 p, int *ix, int *iy, int *iz)
+{
+    *ix = (int)floor((p.x - g->lo.x) / g->cell), *iy = (int)floor((p.y - g->lo.y) / g->cell);
+    *iz = (int)floor((p.z - g->lo.z) / g->cell);
+    return *ix >= 0 && *ix < g->nx && *iy >= 0 && *iy < g->ny && *iz >= 0 && *iz < g->nz;
+}
+
+static void grid_insert(band_grid *g, dem_vec3 p, double r)
+{
+    int ix, iy, iz;
+    if (g->count == g->cap || !cell_of(g, p, &ix, &iy, &iz)) return; // outside the band: cannot touch it
+    size_t c = ((size_t)iz * (size_t)g->ny + (size_t)iy) * (size_t)g->nx + (size_t)ix;
+    g->p[g->count] = p, g->r[g->count] = r, g->next[g->count] = g->head[c];
+    g->head[c] = (int)g->count++;
+}
+
+static int grid_overlaps(const band_grid *g, dem_vec3 p, double r)
+{
+    int cx, cy, cz;
+    cell_of(g, p, &cx, &cy, &cz);
+    for (int iz = cz - 1; iz <= cz + 1; ++iz)
+        for (int iy = cy - 1; iy <= cy + 1; ++iy)
+            for (int ix = cx - 1; ix <= cx + 1; ++ix) {
+                if (ix < 0 || iy < 0 || iz < 0 || ix >= g->nx || iy >= g->ny || iz >= g->nz) continue;
+                for (int k = g->head[((size_t)iz * (size_t)g->ny + (size_t)iy) * (size_t)g->nx + (size_t)ix]; k >= 0;
+                     k = g->next[k]) {
+                    double reach = r + g->r[k];
+                    if (dem_v3_norm2(dem_v3_sub(g->p[k], p)) < reach * reach) return 1;
+                }
+            }
+    return 0;
+}
+
+static void grid_free(band_grid *g) { free(g->head), free(g->next), free(g->p), free(g->r); }
+
+// The band [y0, top] of the region, one cell more all round, holding the
+// granules already there and room for `more`.
+static int grid_make(band_grid *g, const dem_world *w, const exp_pour_region *region, double y0, double top,
+                     double cell, size_t more)
+{
+    dem_granules_view v = dem_world_granules(w);
+    *g = (band_grid){.lo = dem_v3(region->lo.x - cell, y0 - cell, region->lo.z - cell), .cell = cell};
+    g->nx = (int)((region->hi.x - region->lo.x) / cell) + 3, g->ny = (int)((top - y0) / cell) + 3;
+    g->nz = (int)((region->hi.z - region->lo.z) / cell) + 3;
+    size_t cells = (size_t)g->nx * (size_t)g->ny * (size_t)g->nz;
+    g->cap = v.count + more;
+    g->head = malloc(cells * sizeof *g->head), g->next = malloc(g->cap * sizeof *g->next);
+    g->p = malloc(g->cap * sizeof *g->p), g->r = malloc(g->cap * sizeof *g->r);
+    if (!g->head || !g->next || !g->p || !g->r) return grid_free(g), 1;
+    for (size_t c = 0; c < cells; ++c) g->head[c] = -1;
+    for (size_t i = 0; i < v.count; ++i) grid_insert(g, v.position[i], v.radius[i]);
+    return 0;
+}
+
+size_t exp_pack_band(dem_world *w, const exp_pour_region *region, double floor_y, double top, const double *diam,
+                     size_t next, size_t n, double density, unsigned long long seed, int tries)
+{
+    double y0 = exp_bed_surface(w, floor_y), largest = 0;
+    for (size_t k = next; k < n; ++k) largest = fmax(largest, diam[k]);
+    dem_granules_view v = dem_world_granules(w);
+    for (size_t i = 0; i < v.count; ++i) largest = fmax(largest, 2 * v.radius[i]);
+    if (!(top > y0) || next >= n) return 0;
+    band_grid g;
+    if (grid_make(&g, w, region, y0, top, largest, n - next)) return 0;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (!rng) return grid_free(&g), 0;
+    gsl_rng_set(rng, (unsigned long)seed);
+    size_t placed = 0;
+    for (size_t k = next; k < n; ++k) {
+        double r = 0.5 * diam[k];
+        int found = 0;
+        dem_vec3 p;
+        for (int t = 0; t < tries && !found; ++t) {
+            p = dem_v3(region->lo.x + (region->hi.x - region->lo.x) * gsl_rng_uniform(rng), y0 + r + (top - y0 - r) * gsl_rng_uniform(rng),
+                       region->lo.z + (region->hi.z - region->lo.z) * gsl_rng_uniform(rng));
+            found = region->inside(p, region->ctx) && !grid_overlaps(&g, p, r);
+        }
+        if (!found || dem_world_add_granule(w, p, dem_v3(0, 0, 0), dem_v3(0, 0, 0), r, density) < 0) break;
+        grid_insert(&g, p, r);
+        placed++;
+    }
+    gsl_rng_free(rng);
+    grid_free(&g);
     return placed;
 }
 

@@ -31,6 +31,17 @@ double exp_bed_surface(const dem_world *w, double floor_y);
 size_t exp_pour_layer(dem_world *w, const exp_pour_region *region, double floor_y, const double *diam, size_t next,
                       size_t n, double pitch, double density);
 
+/// Place granules next.. of `diam` one by one at uniformly random points of
+/// the region between the bed surface and height `top`, each where it
+/// overlaps no granule (random sequential addition, in the order given, at
+/// rest): a loose random packing (solid fraction about 0.3) that settles by
+/// falling a fraction of its height, instead of layer after layer falling
+/// from a lattice. A granule that finds no room in `tries` random points
+/// ends the band. `seed` makes the points reproducible. Returns how many were
+/// placed (0: no room).
+size_t exp_pack_band(dem_world *w, const exp_pour_region *region, double floor_y, double top, const double *diam,
+                     size_t next, size_t n, double density, unsigned long long seed, int tries);
+
 /// Remove the granules whose centres lie above height y (a bed cut level).
 void exp_remove_above(dem_world *w, double y);
 
