@@ -31,6 +31,7 @@ typedef struct cal_tier {
     double window;          ///< s, steady-state averaging window
     double sample_interval; ///< s between drum-face measurements
     double steady_angle_tol_deg, steady_csa_tol_percent;
+    char *fill_method;      ///< how the drum's bed is built: "pour" (absent) or "pack" (exp_drum_fill_method)
     double *rpm;            ///< speeds simulated; empty = every speed in the data
     unsigned rpm_count;
     double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
@@ -71,6 +72,7 @@ typedef struct cal_rung {
     char *name;
     double lambda, slice_depth, max_time, window; ///< as in a tier
     double sample_interval, steady_angle_tol_deg, steady_csa_tol_percent; ///< optional, as in a tier
+    char *fill_method;                                                    ///< optional, as in a tier
 } cal_rung;
 
 /// The fidelity study (`granucal study fidelity`): the drum lined with

@@ -28,6 +28,7 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     d.def.granule = (dem_contact_params){k_n, k_n, k_n, c->xi, gg_mu_s, gg_mu_r, (dem_damping_mode)mode};
     d.def.wall = (dem_contact_params){2 * k_n, 2 * k_n, 2 * k_n, c->xi, wall_mu_s, wall_mu_r, (dem_damping_mode)mode};
     d.def.end_plate = d.def.wall;
+    if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &d.def.fill_method); // checked on loading
     d.run = exp_default_drum_run_opts();
     d.run.max_time = t->max_time, d.run.window = t->window;
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;

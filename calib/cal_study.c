@@ -76,8 +76,10 @@ typedef struct rung_result {
     double angle[MAX_SPEEDS], angle_sd[MAX_SPEEDS]; ///< mean and spread over seeds
     double csa[MAX_SPEEDS], csa_sd[MAX_SPEEDS];
     int steady[MAX_SPEEDS], usable[MAX_SPEEDS];    ///< runs steady / runs with a measurement
+    double angle_se[MAX_SPEEDS];  ///< standard error of the mean over seeds (independent runs)
     double granules, particle_steps, wall_s, peak_rss_mb, dt_s;
-    double angle_error, csa_error; ///< against the reference rung
+    int runs;                     ///< simulations (seeds x speeds), for the wall time per run
+    double angle_error, csa_error; ///< against the finest rung run
 } rung_result;
 
 typedef struct study {
@@ -87,7 +89,7 @@ typedef struct study {
     char out[1024];
     rung_result res[MAX_RUNGS];
     int n;
-    int reference;               ///< index of the finest rung run
+    int reference;               ///< index of the finest rung run (converged only if shown, see convergence)
     char err[2048];
 } study;
 
@@ -147,7 +149,7 @@ static cal_tier tier_of(const cal_rung *r)
     return (cal_tier){.name = r->name, .lambda = r->lambda, .slice_depth = r->slice_depth, .max_time = r->max_time,
                       .window = r->window, .sample_interval = r->sample_interval,
                       .steady_angle_tol_deg = r->steady_angle_tol_deg,
-                      .steady_csa_tol_percent = r->steady_csa_tol_percent};
+                      .steady_csa_tol_percent = r->steady_csa_tol_percent, .fill_method = r->fill_method};
 }
 
 static cal_drum_case case_of(const study *s, const cal_rung *r, int seed)
@@ -204,6 +206,7 @@ static int measure_rung(study *s, rung_result *out)
     double angle[MAX_SPEEDS][MAX_SEEDS], csa[MAX_SPEEDS][MAX_SEEDS];
     int n_ok[MAX_SPEEDS] = {0};
     out->granules = out->particle_steps = out->wall_s = out->peak_rss_mb = 0;
+    out->runs = 0;
     for (int seed = 0; seed < f->seeds; ++seed) {
         cal_drum_case d = case_of(s, out->rung, seed);
         cal_record rec[MAX_SPEEDS];
@@ -211,6 +214,7 @@ static int measure_rung(study *s, rung_result *out)
         for (unsigned k = 0; k < f->rpm_count; ++k) {
             const cal_record *r = &rec[k];
             out->wall_s += r->wall_time_s + r->fill_wall_time_s;
+            out->runs++;
             out->particle_steps += r->particle_steps;
             out->peak_rss_mb = fmax(out->peak_rss_mb, r->peak_rss_mb);
             if (cal_record_usable(r) && isfinite(r->angle_deg)) {
@@ -226,6 +230,9 @@ static int measure_rung(study *s, rung_result *out)
     for (unsigned k = 0; k < f->rpm_count; ++k) {
         out->usable[k] = n_ok[k], usable += n_ok[k];
         mean_sd(angle[k], n_ok[k], &out->angle[k], &out->angle_sd[k]);
+        // Seeds are independent runs, so their means are independent samples:
+        // no correction for the frames' correlation within a run is needed here.
+        out->angle_se[k] = out->angle_sd[k] / sqrt((double)n_ok[k]);
         mean_sd(csa[k], n_ok[k], &out->csa[k], &out->csa_sd[k]);
     }
     out->granules = usable ? out->granules / usable : NAN;
@@ -272,28 +279,29 @@ static int write_csv(const study *s, char *err, size_t len)
     cal_atomic_file a;
     snprintf(path, sizeof path, "%s/fidelity.csv", s->out);
     if (cal_atomic_open(&a, path, err, len)) return 1;
-    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,seeds,rpm,angle_deg,angle_sd_seeds_deg,csa_percent,"
+    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,seeds,rpm,angle_deg,angle_sd_seeds_deg,angle_se_deg,csa_percent,"
           "csa_sd_seeds_percent,steady_runs,usable_runs\n",
           a.f);
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
         if (!r->ran) continue;
         for (unsigned k = 0; k < f->rpm_count; ++k)
-            fprintf(a.f, "%s,%g,%g,%g,%g,%d,%g,%.3f,%.3f,%.3f,%.3f,%d,%d\n", r->rung->name, r->rung->lambda,
+            fprintf(a.f, "%s,%g,%g,%g,%g,%d,%g,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d\n", r->rung->name, r->rung->lambda,
                     r->rung->slice_depth, r->rung->max_time, r->rung->window, f->seeds, f->rpm[k], r->angle[k],
-                    r->angle_sd[k], r->csa[k], r->csa_sd[k], r->steady[k], r->usable[k]);
+                    r->angle_sd[k], r->angle_se[k], r->csa[k], r->csa_sd[k], r->steady[k], r->usable[k]);
     }
     if (cal_atomic_commit(&a, err, len)) return 1;
     snprintf(path, sizeof path, "%s/fidelity_summary.csv", s->out);
     if (cal_atomic_open(&a, path, err, len)) return 1;
-    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,status,granules,particle_steps,wall_time_s,"
-          "predicted_wall_time_s,peak_rss_mb,dt_s,angle_error_deg,csa_rms_error_percent,reference\n",
+    fputs("rung,lambda,slice_depth_m,max_time_s,window_s,status,granules,particle_steps,wall_time_s,wall_time_per_run_s,"
+          "predicted_wall_time_s,peak_rss_mb,dt_s,angle_error_deg,csa_rms_error_percent,finest_rung\n",
           a.f);
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
-        fprintf(a.f, "%s,%g,%g,%g,%g,%s,%.0f,%.4g,%.1f,%.4g,%.1f,%.4g,%.3f,%.3f,%s\n", r->rung->name, r->rung->lambda,
+        fprintf(a.f, "%s,%g,%g,%g,%g,%s,%.0f,%.4g,%.1f,%.1f,%.4g,%.1f,%.4g,%.3f,%.3f,%s\n", r->rung->name, r->rung->lambda,
                 r->rung->slice_depth, r->rung->max_time, r->rung->window, r->ran ? "run" : "not run (over budget)",
-                r->ran ? r->granules : NAN, r->ran ? r->particle_steps : NAN, r->ran ? r->wall_s : NAN, r->predicted_s,
+                r->ran ? r->granules : NAN, r->ran ? r->particle_steps : NAN, r->ran ? r->wall_s : NAN,
+                r->ran && r->runs ? r->wall_s / r->runs : NAN, r->predicted_s,
                 r->ran ? r->peak_rss_mb : NAN, r->ran ? r->dt_s : NAN, r->angle_error, r->csa_error,
                 s->reference >= 0 ? s->res[s->reference].rung->name : "");
     }
@@ -324,6 +332,48 @@ static void with_spread(char *out, size_t len, double mean, double sd)
     else snprintf(out, len, "%.2f", mean);
 }
 
+// Within 1° (angle at the first speed) and 1 point (CSA rms over the speeds)
+// of the finest rung: the bar for "converged there".
+#define CONVERGED_ANGLE_DEG 1.0
+#define CONVERGED_CSA_PERCENT 1.0
+
+static int within_band(const rung_result *r)
+{
+    return r->ran && r->angle_error <= CONVERGED_ANGLE_DEG && r->csa_error <= CONVERGED_CSA_PERCENT;
+}
+
+// Which rungs agree with the finest one, and whether the ladder has been
+// shown converged there: only if the next coarser scale factor run also
+// agrees (a plateau); a rung is never called converged because it is the
+// finest reached.
+static void write_convergence(FILE *o, const study *s)
+{
+    if (s->reference < 0) return;
+    const rung_result *ref = &s->res[s->reference];
+    const rung_result *coarsest = NULL, *next = NULL;
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran || i == s->reference) continue;
+        if (within_band(r) && (!coarsest || r->rung->lambda > coarsest->rung->lambda)) coarsest = r;
+        if (r->rung->lambda > ref->rung->lambda && (!next || r->rung->lambda < next->rung->lambda)) next = r;
+    }
+    fprintf(o, "\nThe finest rung run is %s (λ %g). ", ref->rung->name, ref->rung->lambda);
+    if (coarsest)
+        fprintf(o, "The coarsest rung within %g° and %g point of it is %s (λ %g). ", CONVERGED_ANGLE_DEG,
+                CONVERGED_CSA_PERCENT, coarsest->rung->name, coarsest->rung->lambda);
+    else fprintf(o, "No other rung lies within %g° and %g point of it. ", CONVERGED_ANGLE_DEG, CONVERGED_CSA_PERCENT);
+    if (next && within_band(next))
+        fprintf(o, "The next coarser λ run (%s, λ %g) agrees with it within that band, so the ladder has levelled off "
+                   "there, as far as these seeds tell.\n",
+                next->rung->name, next->rung->lambda);
+    else if (next)
+        fprintf(o, "**The ladder has not been shown converged:** between %s (λ %g) and %s (λ %g) the angle still moves "
+                   "by %.2f° and the CSA by %.2f points.\n",
+                next->rung->name, next->rung->lambda, ref->rung->name, ref->rung->lambda, next->angle_error,
+                next->csa_error);
+    else fputs("**No coarser λ was run beside it: its convergence is not shown.**\n", o);
+}
+
 static int write_markdown(const study *s, const char *command, double wall, char *err, size_t len)
 {
     const cal_fidelity *f = s->c->fidelity;
@@ -340,9 +390,12 @@ static int write_markdown(const study *s, const char *command, double wall, char
                "speeds",
             s->c->granule_mu_s, s->c->granule_mu_r, s->c->k_n, f->seeds);
     for (unsigned k = 0; k < f->rpm_count; ++k) fprintf(o, " %g", f->rpm[k]);
-    fputs(" rpm. The angle is the first speed's; errors are against the reference rung (the finest run).\n\n", o);
-    fputs("| rung | λ | depth | run / window (s) | granules | angle (°) ± seeds | CSA (%) ± seeds | angle error (°) | "
-          "CSA rms error (%) | wall (s) | particle-steps | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    fputs(" rpm. The angle is the first speed's, with the standard error of its mean over the seeds (independent "
+          "runs: sd / sqrt(seeds)); errors are against the finest rung run.\n\n",
+          o);
+    fputs("| rung | λ | depth | run / window (s) | granules | angle (°) ± SE | SE ≤ 0.5°? | CSA (%) ± seeds | "
+          "angle error (°) | CSA rms error (%) | wall per run (s) | particle-steps | peak MiB |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
           o);
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
@@ -350,17 +403,20 @@ static int write_markdown(const study *s, const char *command, double wall, char
         if (r->rung->slice_depth > 0) snprintf(depth, sizeof depth, "%g mm slice", 1e3 * r->rung->slice_depth);
         else snprintf(depth, sizeof depth, "full drum");
         if (!r->ran) {
-            fprintf(o, "| %s | %g | %s | %g / %g | not run | | | | | predicted %.3g h | | |\n", r->rung->name,
-                    r->rung->lambda, depth, r->rung->max_time, r->rung->window, r->predicted_s / 3600);
+            fprintf(o, "| %s | %g | %s | %g / %g | not run | | | | | | predicted %.3g h for the rung | | |\n",
+                    r->rung->name, r->rung->lambda, depth, r->rung->max_time, r->rung->window, r->predicted_s / 3600);
             continue;
         }
         char angle[48], csa[48];
-        with_spread(angle, sizeof angle, r->angle[0], r->angle_sd[0]);
+        with_spread(angle, sizeof angle, r->angle[0], r->angle_se[0]);
         with_spread(csa, sizeof csa, r->csa[0], r->csa_sd[0]);
-        fprintf(o, "| %s%s | %g | %s | %g / %g | %.0f | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n", r->rung->name,
-                i == s->reference ? " (reference)" : "", r->rung->lambda, depth, r->rung->max_time, r->rung->window,
-                r->granules, angle, csa, r->angle_error, r->csa_error, r->wall_s, r->particle_steps, r->peak_rss_mb);
+        fprintf(o, "| %s%s | %g | %s | %g / %g | %.0f | %s | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n", r->rung->name,
+                i == s->reference ? " (finest)" : "", r->rung->lambda, depth, r->rung->max_time, r->rung->window,
+                r->granules, angle, isfinite(r->angle_se[0]) ? (r->angle_se[0] <= 0.5 ? "yes" : "no") : "one seed",
+                csa, r->angle_error, r->csa_error, r->runs ? r->wall_s / r->runs : NAN, r->particle_steps,
+                r->peak_rss_mb);
     }
+    write_convergence(o, s);
     fputs("\nThe paper's Table B.1 (aluminium drum, calibrated model; its rpm is not stated), beside the rungs:\n\n"
           "| λ | angle (°) | CSA (%) |\n|---|---|---|\n",
           o);

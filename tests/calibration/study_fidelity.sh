@@ -26,7 +26,14 @@ summary="$work/out/fidelity_summary.csv"
 cat "$summary"
 field() { awk -F, -v r="$1" -v c="$2" 'NR==1{for(i=1;i<=NF;i++)h[$i]=i;next} $1==r{print $h[c]}' "$summary"; }
 [ "$(field coarse-long status)" = run ] && [ "$(field coarse status)" = run ] || { echo "the cheap rungs did not run"; exit 1; }
-[ "$(field coarse-long reference)" = coarse-long ] || { echo "the longer run of the same lambda is not the reference"; exit 1; }
+[ "$(field coarse-long finest_rung)" = coarse-long ] || { echo "the longer run of the same lambda is not the finest rung"; exit 1; }
+awk -v w="$(field coarse wall_time_per_run_s)" 'BEGIN{exit !(w > 0 && w < 900)}' || { echo "no wall time per run"; exit 1; }
+# The finest rung is named as such, never "reference", and no convergence is claimed that
+# the ladder did not show (no coarser lambda than the finest was run here).
+grep -q "The finest rung run is coarse-long" "$work/out/fidelity.md" || { echo "fidelity.md names no finest rung"; exit 1; }
+grep -q "reference" "$work/out/fidelity.md" && { echo "fidelity.md still calls a rung the reference"; exit 1; }
+grep -q "No coarser λ was run beside it: its convergence is not shown" "$work/out/fidelity.md" ||
+  { echo "fidelity.md claims or omits convergence"; exit 1; }
 awk -v e="$(field coarse-long angle_error_deg)" 'BEGIN{exit !(e == 0)}' || { echo "reference error not 0"; exit 1; }
 awk -v e="$(field coarse angle_error_deg)" 'BEGIN{exit !(e >= 0 && e < 90)}' || { echo "no finite angle error"; exit 1; }
 [ "$(field L8-full status)" = "not run (over budget)" ] || { echo "the lambda 8 rung should be over the budget"; exit 1; }
