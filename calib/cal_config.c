@@ -37,6 +37,7 @@ static const cyaml_schema_field_t tier_fields[] = {
     TIER_FLOAT("steady_angle_tol_deg", steady_angle_tol_deg, CYAML_FLAG_OPTIONAL),
     TIER_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, fill_method, 1, 16),
+    TIER_FLOAT("average_time", average_time, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
     TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
     CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
@@ -64,6 +65,7 @@ static const cyaml_schema_field_t rung_fields[] = {
     RUNG_FLOAT("steady_angle_tol_deg", steady_angle_tol_deg, CYAML_FLAG_OPTIONAL),
     RUNG_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_rung, fill_method, 1, 16),
+    RUNG_FLOAT("average_time", average_time, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t rung_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_rung, rung_fields)};
 
@@ -162,8 +164,12 @@ static int block_of(const cal_config *c, const char *name)
 // The knobs a tier and a rung share; `optional` holds sample_interval,
 // steady_angle_tol_deg and steady_csa_tol_percent (0 or absent: the drum's default).
 static int check_drum_knobs(const cal_config *c, int from, double lambda, double slice_depth, double max_time,
-                            double window, const double optional[3], const char *fill_method, char *err, size_t len)
+                            double window, const double optional[3], const char *fill_method, double average_time,
+                            char *err, size_t len)
 {
+    if (!(isfinite(average_time) && average_time >= 0 && 2 * window + average_time <= max_time))
+        return located(c, from, "average_time", err, len, "%g must be >= 0 and fit with two windows (%g s) in max_time (%g s)",
+                       average_time, 2 * window, max_time);
     exp_drum_fill_method method;
     if (fill_method && exp_drum_fill_method_from_name(fill_method, &method))
         return located(c, from, "fill_method", err, len, "'%s': use pour or pack", fill_method);
@@ -185,7 +191,8 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
     const double optional[3] = {t->sample_interval, t->steady_angle_tol_deg, t->steady_csa_tol_percent};
-    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, t->fill_method, err, len))
+    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, t->fill_method, t->average_time, err,
+                         len))
         return 1;
     if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
@@ -240,7 +247,7 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
                 return located(c, from, "fidelity.rungs", err, len, "rung '%s' is defined twice", r->name);
         const double optional[3] = {r->sample_interval, r->steady_angle_tol_deg, r->steady_csa_tol_percent};
         if (check_drum_knobs(c, block_of(c, r->name), r->lambda, r->slice_depth, r->max_time, r->window, optional,
-                             r->fill_method, err, len))
+                             r->fill_method, r->average_time, err, len))
             return 1;
     }
     return 0;

@@ -32,6 +32,7 @@ typedef struct cal_tier {
     double sample_interval; ///< s between drum-face measurements
     double steady_angle_tol_deg, steady_csa_tol_percent;
     char *fill_method;      ///< how the drum's bed is built: "pour" (absent) or "pack" (exp_drum_fill_method)
+    double average_time;    ///< s averaged on after the steady test holds (exp_drum_run_opts; 0: none)
     double *rpm;            ///< speeds simulated; empty = every speed in the data
     unsigned rpm_count;
     double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
@@ -73,6 +74,7 @@ typedef struct cal_rung {
     double lambda, slice_depth, max_time, window; ///< as in a tier
     double sample_interval, steady_angle_tol_deg, steady_csa_tol_percent; ///< optional, as in a tier
     char *fill_method;                                                    ///< optional, as in a tier
+    double average_time;                                                  ///< optional, as in a tier
 } cal_rung;
 
 /// The fidelity study (`granucal study fidelity`): the drum lined with

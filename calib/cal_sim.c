@@ -30,6 +30,7 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     d.def.end_plate = d.def.wall;
     if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &d.def.fill_method); // checked on loading
     d.run = exp_default_drum_run_opts();
+    d.run.average_time = t->average_time;
     d.run.max_time = t->max_time, d.run.window = t->window;
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
     if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
@@ -103,6 +104,8 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
              "tol=%.10g,%.10g network_dt=%d start_tilt=%.10g",
              def, fill_wall, c->def.periodic ? "none" : fill_plate, rpm, r->max_time, r->sample_interval, r->window,
              r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt, r->start_tilt_deg);
+    // Named only when set, so that every record stored before it keeps its key.
+    if (r->average_time > 0) snprintf(out + strlen(out), len - strlen(out), " average_time=%.10g", r->average_time);
 }
 
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)

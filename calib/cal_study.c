@@ -149,7 +149,8 @@ static cal_tier tier_of(const cal_rung *r)
     return (cal_tier){.name = r->name, .lambda = r->lambda, .slice_depth = r->slice_depth, .max_time = r->max_time,
                       .window = r->window, .sample_interval = r->sample_interval,
                       .steady_angle_tol_deg = r->steady_angle_tol_deg,
-                      .steady_csa_tol_percent = r->steady_csa_tol_percent, .fill_method = r->fill_method};
+                      .steady_csa_tol_percent = r->steady_csa_tol_percent, .fill_method = r->fill_method,
+                      .average_time = r->average_time};
 }
 
 static cal_drum_case case_of(const study *s, const cal_rung *r, int seed)
@@ -393,7 +394,7 @@ static int write_markdown(const study *s, const char *command, double wall, char
     fputs(" rpm. The angle is the first speed's, with the standard error of its mean over the seeds (independent "
           "runs: sd / sqrt(seeds)); errors are against the finest rung run.\n\n",
           o);
-    fputs("| rung | λ | depth | run / window (s) | granules | angle (°) ± SE | SE ≤ 0.5°? | CSA (%) ± seeds | "
+    fputs("| rung | λ | depth | run / window / averaged on (s) | granules | angle (°) ± SE | SE ≤ 0.5°? | CSA (%) ± seeds | "
           "angle error (°) | CSA rms error (%) | wall per run (s) | particle-steps | peak MiB |\n"
           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
           o);
@@ -403,15 +404,17 @@ static int write_markdown(const study *s, const char *command, double wall, char
         if (r->rung->slice_depth > 0) snprintf(depth, sizeof depth, "%g mm slice", 1e3 * r->rung->slice_depth);
         else snprintf(depth, sizeof depth, "full drum");
         if (!r->ran) {
-            fprintf(o, "| %s | %g | %s | %g / %g | not run | | | | | | predicted %.3g h for the rung | | |\n",
-                    r->rung->name, r->rung->lambda, depth, r->rung->max_time, r->rung->window, r->predicted_s / 3600);
+            fprintf(o, "| %s | %g | %s | %g / %g / %g | not run | | | | | | predicted %.3g h for the rung | | |\n",
+                    r->rung->name, r->rung->lambda, depth, r->rung->max_time, r->rung->window, r->rung->average_time,
+                    r->predicted_s / 3600);
             continue;
         }
         char angle[48], csa[48];
         with_spread(angle, sizeof angle, r->angle[0], r->angle_se[0]);
         with_spread(csa, sizeof csa, r->csa[0], r->csa_sd[0]);
-        fprintf(o, "| %s%s | %g | %s | %g / %g | %.0f | %s | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n", r->rung->name,
-                i == s->reference ? " (finest)" : "", r->rung->lambda, depth, r->rung->max_time, r->rung->window,
+        fprintf(o, "| %s%s | %g | %s | %g / %g / %g | %.0f | %s | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n",
+                r->rung->name, i == s->reference ? " (finest)" : "", r->rung->lambda, depth, r->rung->max_time,
+                r->rung->window, r->rung->average_time,
                 r->granules, angle, isfinite(r->angle_se[0]) ? (r->angle_se[0] <= 0.5 ? "yes" : "no") : "one seed",
                 csa, r->angle_error, r->csa_error, r->runs ? r->wall_s / r->runs : NAN, r->particle_steps,
                 r->peak_rss_mb);

@@ -248,7 +248,7 @@ exp_drum_run_opts exp_default_drum_run_opts(void)
 {
     return (exp_drum_run_opts){.rpm = 4, .max_time = 6, .sample_interval = 0.05, .window = 1.0,
                                .angle_tol_deg = 1.0, .csa_tol_percent = 0.5, .adopt_network_dt = 1,
-                               .start_tilt_deg = 20.0};
+                               .start_tilt_deg = 20.0, .average_time = 0};
 }
 
 dem_status exp_drum_tilt(dem_world *w, double degrees)
@@ -295,17 +295,20 @@ static int is_steady(const exp_drum_measure *m, int count, int per_window, const
 typedef struct turn_state {
     exp_drum_measure *m; // one per sample
     int count, cap;
+    int steady_from; // first sample of the averaged span once steady, else -1
+    int steady_at;   // samples there were when the steady test first held
     uint64_t steps;
     double t0, earlier_wall_s;
 } turn_state;
 
-enum { MEASURE_DOUBLES = 4, TURN_DOUBLES = 4 };
+enum { MEASURE_DOUBLES = 4, TURN_DOUBLES = 6 };
 _Static_assert(sizeof(exp_drum_measure) == MEASURE_DOUBLES * sizeof(double), "a measurement is saved as 4 doubles");
 
 static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_state *s, double wall_s, char *err,
                      size_t len)
 {
-    double turn[TURN_DOUBLES] = {s->t0, (double)s->steps, s->earlier_wall_s + wall_s, o->start_tilt_deg};
+    double turn[TURN_DOUBLES] = {s->t0,           (double)s->steps,       s->earlier_wall_s + wall_s,
+                                 o->start_tilt_deg, (double)s->steady_from, (double)s->steady_at};
     dem_checkpoint_array extra[2] = {{"turn", turn, TURN_DOUBLES},
                                      {"measurements", (double *)s->m, (size_t)s->count * MEASURE_DOUBLES}};
     return dem_checkpoint_write(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, len);
@@ -323,6 +326,7 @@ static int resume_turn(dem_world *w, const exp_drum_run_opts *o, turn_state *s, 
     if (ok) {
         s->t0 = extra[0].data[0], s->steps = (uint64_t)extra[0].data[1], s->earlier_wall_s = extra[0].data[2];
         out->start_tilt_deg = extra[0].data[3];
+        s->steady_from = (int)extra[0].data[4], s->steady_at = (int)extra[0].data[5];
         s->count = (int)(extra[1].count / MEASURE_DOUBLES);
         memcpy(s->m, extra[1].data, extra[1].count * sizeof(double));
     } else if (rc != 1)
@@ -361,7 +365,8 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
 {
     memset(out, 0, sizeof *out);
     int per_window = (int)(o->window / o->sample_interval + 0.5);
-    turn_state s = {.cap = (int)(o->max_time / o->sample_interval) + 2};
+    int avg_samples = (int)(o->average_time / o->sample_interval + 0.5);
+    turn_state s = {.cap = (int)(o->max_time / o->sample_interval) + 2, .steady_from = -1};
     s.m = malloc((size_t)s.cap * sizeof *s.m);
     if (!s.m) return DEM_ERR_NOMEM;
     out->resumed = o->checkpoint && resume_turn(w, o, &s, out);
@@ -370,13 +375,14 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     out->earlier_wall_s = s.earlier_wall_s;
     uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
-    out->steady = is_steady(s.m, s.count, per_window, o);
-    while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval && !out->steady) {
+    while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval &&
+           !(s.steady_from >= 0 && s.count - s.steady_at >= avg_samples)) {
         st = dem_world_step(w, chunk);
         s.steps += chunk;
         if (st != DEM_OK || exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count])) break;
         s.count++;
-        out->steady = is_steady(s.m, s.count, per_window, o);
+        if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
+            s.steady_from = s.count - 2 * per_window, s.steady_at = s.count;
         if (progress) progress("turn", dem_world_time(w) - s.t0, dem_world_granules(w).count, ctx);
         double now = exp_wall_seconds();
         if (o->checkpoint && now - saved >= o->checkpoint->every_s) {
@@ -388,8 +394,11 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     }
     // The two windows the steady test compared are one state: both are
     // averaged (a slumping bed's saw-tooth makes one window's mean depend on
-    // where in an avalanche cycle it starts).
-    int from = s.count > 2 * per_window ? s.count - 2 * per_window : 0;
+    // where in an avalanche cycle it starts), and so is every sample after
+    // them (average_time). Not steady: the last two windows.
+    out->steady = s.steady_from >= 0;
+    int from = out->steady ? s.steady_from : s.count > 2 * per_window ? s.count - 2 * per_window : 0;
+    out->averaged_time_s = (s.count - from) * o->sample_interval;
     window_stats ws = s.count ? stats_of(s.m, from, s.count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
     free(s.m);
     out->angle_deg = ws.mean_angle, out->angle_sd_deg = ws.sd_angle;

@@ -98,6 +98,12 @@ typedef struct exp_drum_run_opts {
     /// which a real drum does before it avalanches. Saves the rigid turn a
     /// level bed needs before its first avalanche (0.8 s of 6 s at 4 rpm).
     double start_tilt_deg;
+    /// s of turning averaged on after the steady test first holds (0: none,
+    /// the two windows it compared are the result). The angle of a slumping
+    /// bed saw-tooths with each avalanche (about one a second at 4 rpm), so a
+    /// run's mean over two windows carries a few avalanches' noise; a study
+    /// that needs the mean to a given error averages longer.
+    double average_time;
     /// NULL: no checkpoints. Not part of what defines a run: a run resumed
     /// from its checkpoints ends as the same run uninterrupted would.
     const exp_drum_checkpoint *checkpoint;
@@ -109,8 +115,9 @@ exp_drum_run_opts exp_default_drum_run_opts(void);
 /// positive rpm turns the drum (dem_world_rotate: springs turn with it).
 dem_status exp_drum_tilt(dem_world *w, double degrees);
 
-/// What a rotation run measured: means and spreads over the last two windows
-/// (the pair the steady test compared; what there is of them if shorter).
+/// What a rotation run measured: means and spreads over the two windows the
+/// steady test compared and the average_time after them (not steady: the last
+/// two windows, or what there is of them).
 typedef struct exp_drum_result {
     double angle_deg, angle_sd_deg, csa_percent, csa_sd_percent;
     double fit_sd_m;        ///< mean spread of the surface about its fitted line
@@ -120,6 +127,7 @@ typedef struct exp_drum_result {
     /// Wall seconds the run had cost before the checkpoint it resumed from
     /// (0: not resumed); a caller timing the run adds them to its own clock.
     double earlier_wall_s;
+    double averaged_time_s;      ///< s of turning the means and spreads are over
     int resumed;                 ///< 1: resumed from a checkpoint
     char checkpoint_note[512];   ///< why a checkpoint found was not resumed, else ""
     unsigned long long particle_steps;

@@ -49,6 +49,8 @@ expect "negative CSA spread" "csa_sd_percent: -0.55 must be in [0, 50)" -- "$(ed
 expect "fractional --jobs" "--jobs '2.5': expected a whole number in 1..1024" -- "$work/configs/good.yaml" --jobs 2.5 "${out[@]}"
 expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perhaps" -- "$(edit probes 's/bound_probes: false/bound_probes: perhaps/')" "${out[@]}"
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
+expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
+expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm 's/^    max_time: 1.5/    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
 expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
 expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
