@@ -159,20 +159,25 @@ int dem_checkpoint_write(const dem_world *w, const char *path, const char *key, 
 
 // ---- reading ----------------------------------------------------------------
 
-// A saved array of exactly `count` entries of `type` into `dst`.
-static void get(ck_file *c, const char *name, hid_t type, size_t count, void *dst)
+// The entries of saved array `name` into *count; 0, or −1 (the file fails) if it is not there.
+static int array_length(ck_file *c, const char *name, size_t *count)
 {
-    if (c->failed) return;
     hsize_t dims[1] = {0};
     H5T_class_t cls;
     size_t size;
-    if (H5LTget_dataset_info(c->f, name, dims, &cls, &size) < 0) {
-        ck_fail(c, "has no array", name);
-        return;
-    }
-    if (dims[0] != count) {
-        snprintf(c->err, c->len, "checkpoint '%s': array %s holds %llu entries, the world needs %zu (damaged file)",
-                 c->path, name, (unsigned long long)dims[0], count);
+    if (H5LTget_dataset_info(c->f, name, dims, &cls, &size) < 0) return ck_fail(c, "has no array", name);
+    *count = (size_t)dims[0];
+    return 0;
+}
+
+// A saved array of exactly `count` entries of `type` into `dst`.
+static void get(ck_file *c, const char *name, hid_t type, size_t count, void *dst)
+{
+    size_t saved;
+    if (c->failed || array_length(c, name, &saved)) return;
+    if (saved != count) {
+        snprintf(c->err, c->len, "checkpoint '%s': array %s holds %zu entries, the world needs %zu (damaged file)",
+                 c->path, name, saved, count);
         c->failed = 1;
         return;
     }
@@ -295,14 +300,7 @@ static void read_extra(ck_file *c, dem_checkpoint_array *extra, int n_extra)
     for (int k = 0; k < n_extra && !c->failed; ++k) {
         char name[256];
         snprintf(name, sizeof name, "/caller/%s", extra[k].name);
-        hsize_t dims[1] = {0};
-        H5T_class_t cls;
-        size_t size;
-        if (H5LTget_dataset_info(c->f, name, dims, &cls, &size) < 0) {
-            ck_fail(c, "has no array", name);
-            return;
-        }
-        extra[k].count = (size_t)dims[0];
+        if (array_length(c, name, &extra[k].count)) return;
         extra[k].data = alloc_or_fail(c, extra[k].count * sizeof(double));
         if (extra[k].count && !c->failed && H5LTread_dataset_double(c->f, name, extra[k].data) < 0)
             ck_fail(c, "cannot read", name);
