@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cal_config.h"
+#include "exp_drum.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
 #include "fuzz_common.h"
@@ -31,6 +32,16 @@ static void check_contact(const char *loader, const dem_contact_params *p)
 {
     finite(loader, "k_n", p->k_n), finite(loader, "k_s", p->k_s), finite(loader, "k_r", p->k_r);
     finite(loader, "xi", p->xi), finite(loader, "mu_s", p->mu_s), finite(loader, "mu_r", p->mu_r);
+}
+
+// A tier's or rung's bed-building and averaging as the drum can run them.
+static void known_fill(const char *fill_method, double average_time, double window, double max_time)
+{
+    exp_drum_fill_method m;
+    if (fill_method && exp_drum_fill_method_from_name(fill_method, &m))
+        fuzz_violation("cal_config_load accepted an unknown fill_method", fill_method);
+    if (!(average_time >= 0 && 2 * window + average_time <= max_time))
+        fuzz_violation("cal_config_load accepted an average_time that does not fit in max_time", NULL);
 }
 
 static void check_config(const cal_config *c, const char *path)
@@ -61,6 +72,7 @@ static void check_config(const cal_config *c, const char *path)
         finite(L, "tier sample_interval", t->sample_interval), finite(L, "tier cylinder_lambda", t->cylinder_lambda);
         finite(L, "tier steady_angle_tol_deg", t->steady_angle_tol_deg), finite(L, "tier angle_sd_deg", t->angle_sd_deg);
         finite(L, "tier steady_csa_tol_percent", t->steady_csa_tol_percent);
+        known_fill(t->fill_method, t->average_time, t->window, t->max_time);
         for (unsigned j = 0; j < t->rpm_count; ++j) finite(L, "tier rpm", t->rpm[j]);
         finite(L, "tier angle_offset_deg", t->angle_offset_deg);
         if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
@@ -82,6 +94,7 @@ static void check_config(const cal_config *c, const char *path)
             finite(L, "rung sample_interval", r->sample_interval);
             finite(L, "rung steady_angle_tol_deg", r->steady_angle_tol_deg);
             finite(L, "rung steady_csa_tol_percent", r->steady_csa_tol_percent);
+            known_fill(r->fill_method, r->average_time, r->window, r->max_time);
         }
     }
 }
