@@ -379,7 +379,11 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
            !(s.steady_from >= 0 && s.count - s.steady_at >= avg_samples)) {
         st = dem_world_step(w, chunk);
         s.steps += chunk;
-        if (st != DEM_OK || exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count])) break;
+        if (st != DEM_OK) break;
+        double measure_start = exp_wall_seconds();
+        int unmeasured = exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count]);
+        out->measure_wall_s += exp_wall_seconds() - measure_start;
+        if (unmeasured) break;
         s.count++;
         if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
             s.steady_from = s.count - 2 * per_window, s.steady_at = s.count;

@@ -128,6 +128,7 @@ typedef struct exp_drum_result {
     /// (0: not resumed); a caller timing the run adds them to its own clock.
     double earlier_wall_s;
     double averaged_time_s;      ///< s of turning the means and spreads are over
+    double measure_wall_s;       ///< wall seconds of this call spent measuring the drum face
     int resumed;                 ///< 1: resumed from a checkpoint
     char checkpoint_note[512];   ///< why a checkpoint found was not resumed, else ""
     unsigned long long particle_steps;
