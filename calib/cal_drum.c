@@ -8,6 +8,7 @@
 #include "cal_commands.h"
 #include "cal_sim.h"
 #include "cal_util.h"
+#include "dem_checkpoint.h"
 #include "exp_common.h"
 #include "dem_output.h"
 #include "exp_drum_config.h"
@@ -98,11 +99,10 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
     }
     run.rpm = y->rpm = rpm;
     // The run's checkpoint, labelled with what defines it (as a calibration's record).
-    char key[2048], ck_path[1200], ck_tmp[1210];
+    char key[2048], ck_path[1200];
     cal_drum_case whole = {*def, *def, run};
     cal_drum_key(&whole, rpm, key, sizeof key);
     snprintf(ck_path, sizeof ck_path, "%s/checkpoint.h5", sub);
-    snprintf(ck_tmp, sizeof ck_tmp, "%s.tmp", ck_path);
     exp_drum_checkpoint ck = {ck_path, key, checkpoint_every_s};
     if (checkpoint_every_s > 0) run.checkpoint = &ck;
     double t0 = exp_wall_seconds();
@@ -115,7 +115,7 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
     const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: %g rpm: %s\n", rpm, dem_world_error(w));
     int bad = save(sub, y, &r, w, status);
-    if (!bad) remove(ck_path), remove(ck_tmp); // result.json holds the result now
+    if (!bad) dem_checkpoint_remove(ck_path); // result.json holds the result now
     if (!first) fputs(", ", json_out);
     write_json(json_out, y, &r, w, status);
     dem_world_destroy(w);

@@ -11,6 +11,7 @@
 #include "cal_mpi.h"
 #include "cal_pool.h"
 #include "cal_util.h"
+#include "dem_checkpoint.h"
 #include "exp_common.h"
 
 static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
@@ -220,9 +221,8 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     run.rpm = b->rpm[r.k];
     dem_world *w = own ? bed : dem_world_clone(bed);
     if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
-    char ck_path[1300], ck_tmp[1310];
+    char ck_path[1300];
     checkpoint_path(b->env, key, ck_path, sizeof ck_path);
-    snprintf(ck_tmp, sizeof ck_tmp, "%s.tmp", ck_path);
     exp_drum_checkpoint ck = {ck_path, key, b->env->checkpoint_every_s};
     if (ck.every_s > 0) run.checkpoint = &ck;
     double t0 = exp_wall_seconds();
@@ -245,7 +245,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     char err[512];
     int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
-    else remove(ck_path), remove(ck_tmp); // the record holds the result now
+    else dem_checkpoint_remove(ck_path); // the record holds the result now
     if (!own) dem_world_destroy(w);
     return bad;
 }

@@ -140,12 +140,24 @@ static int write_file(const dem_world *w, ck_file *c, const char *key, const dem
     return c->failed ? -1 : 0;
 }
 
+// The temporary a checkpoint is written under before it is renamed into place.
+static int temporary_of(const char *path, char *out, size_t len)
+{
+    return snprintf(out, len, "%s.tmp", path) >= (int)len;
+}
+
+void dem_checkpoint_remove(const char *path)
+{
+    char tmp[4096];
+    remove(path);
+    if (!temporary_of(path, tmp, sizeof tmp)) remove(tmp);
+}
+
 int dem_checkpoint_write(const dem_world *w, const char *path, const char *key, const dem_checkpoint_array *extra,
                          int n_extra, char *err, size_t len)
 {
     char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return snprintf(err, len, "checkpoint '%s': path too long", path), 1;
+    if (temporary_of(path, tmp, sizeof tmp)) return snprintf(err, len, "checkpoint '%s': path too long", path), 1;
     dem_h5_quiet q = dem_h5_quiet_begin();
     ck_file c = {H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), path, err, len, 0};
     if (c.f < 0) ck_fail(&c, "cannot create", tmp);

@@ -42,4 +42,8 @@ int dem_checkpoint_write(const dem_world *w, const char *path, const char *key, 
 int dem_checkpoint_read(dem_world *w, const char *path, const char *key, dem_checkpoint_array *extra, int n_extra,
                         char *err, size_t len);
 
+/// Remove the checkpoint at @p path and any temporary a killed write left
+/// beside it (once the run's result is safe elsewhere).
+void dem_checkpoint_remove(const char *path);
+
 #endif
