@@ -191,8 +191,8 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
     const double optional[3] = {t->sample_interval, t->steady_angle_tol_deg, t->steady_csa_tol_percent};
-    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, t->fill_method, t->average_time, err,
-                         len))
+    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, t->fill_method,
+                         t->average_time, err, len))
         return 1;
     if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);

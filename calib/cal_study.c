@@ -89,7 +89,7 @@ typedef struct study {
     char out[1024];
     rung_result res[MAX_RUNGS];
     int n;
-    int reference;               ///< index of the finest rung run (converged only if shown, see convergence)
+    int finest;                  ///< index of the finest rung run (converged only if shown: write_convergence)
     char err[2048];
 } study;
 
@@ -251,17 +251,17 @@ static int finer(const rung_result *a, const rung_result *b)
     return a->rung->window > b->rung->window;
 }
 
-static void errors_against_reference(study *s)
+static void errors_against_finest(study *s)
 {
     const cal_fidelity *f = s->c->fidelity;
-    s->reference = -1;
+    s->finest = -1;
     for (int i = 0; i < s->n; ++i)
-        if (s->res[i].ran && (s->reference < 0 || finer(&s->res[i], &s->res[s->reference]))) s->reference = i;
+        if (s->res[i].ran && (s->finest < 0 || finer(&s->res[i], &s->res[s->finest]))) s->finest = i;
     for (int i = 0; i < s->n; ++i) {
         rung_result *r = &s->res[i];
         r->angle_error = r->csa_error = NAN;
-        if (!r->ran || s->reference < 0) continue;
-        const rung_result *ref = &s->res[s->reference];
+        if (!r->ran || s->finest < 0) continue;
+        const rung_result *ref = &s->res[s->finest];
         // The angle at the first speed (the lab's angle speed, 4 rpm in Table 2);
         // the CSA as the root mean square over the speeds.
         r->angle_error = fabs(r->angle[0] - ref->angle[0]);
@@ -304,7 +304,7 @@ static int write_csv(const study *s, char *err, size_t len)
                 r->ran ? r->granules : NAN, r->ran ? r->particle_steps : NAN, r->ran ? r->wall_s : NAN,
                 r->ran && r->runs ? r->wall_s / r->runs : NAN, r->predicted_s,
                 r->ran ? r->peak_rss_mb : NAN, r->ran ? r->dt_s : NAN, r->angle_error, r->csa_error,
-                s->reference >= 0 ? s->res[s->reference].rung->name : "");
+                s->finest >= 0 ? s->res[s->finest].rung->name : "");
     }
     return cal_atomic_commit(&a, err, len);
 }
@@ -349,12 +349,12 @@ static int within_band(const rung_result *r)
 // finest reached.
 static void write_convergence(FILE *o, const study *s)
 {
-    if (s->reference < 0) return;
-    const rung_result *ref = &s->res[s->reference];
+    if (s->finest < 0) return;
+    const rung_result *ref = &s->res[s->finest];
     const rung_result *coarsest = NULL, *next = NULL;
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
-        if (!r->ran || i == s->reference) continue;
+        if (!r->ran || i == s->finest) continue;
         if (within_band(r) && (!coarsest || r->rung->lambda > coarsest->rung->lambda)) coarsest = r;
         if (r->rung->lambda > ref->rung->lambda && (!next || r->rung->lambda < next->rung->lambda)) next = r;
     }
@@ -413,7 +413,7 @@ static int write_markdown(const study *s, const char *command, double wall, char
         with_spread(angle, sizeof angle, r->angle[0], r->angle_se[0]);
         with_spread(csa, sizeof csa, r->csa[0], r->csa_sd[0]);
         fprintf(o, "| %s%s | %g | %s | %g / %g / %g | %.0f | %s | %s | %s | %.2f | %.2f | %.0f | %.3g | %.0f |\n",
-                r->rung->name, i == s->reference ? " (finest)" : "", r->rung->lambda, depth, r->rung->max_time,
+                r->rung->name, i == s->finest ? " (finest)" : "", r->rung->lambda, depth, r->rung->max_time,
                 r->rung->window, r->rung->average_time,
                 r->granules, angle, isfinite(r->angle_se[0]) ? (r->angle_se[0] <= 0.5 ? "yes" : "no") : "one seed",
                 csa, r->angle_error, r->csa_error, r->runs ? r->wall_s / r->runs : NAN, r->particle_steps,
@@ -445,7 +445,7 @@ static int write_plots(const study *s, char *err, size_t len)
         if (!r->ran) continue;
         lam[m] = r->rung->lambda, ang[m] = r->angle[0], ang_sd[m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
         csa[m] = r->csa[0], csa_sd[m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0, m++;
-        if (i == s->reference) continue; // its error is zero by definition
+        if (i == s->finest) continue; // its error is zero by definition
         cost[n] = r->wall_s, ae[n] = r->angle_error, ce[n] = r->csa_error, n++;
     }
     char path[1200];
@@ -533,7 +533,7 @@ int cal_cmd_study(int argc, char **argv)
         status = run_ladder(s);
     }
     if (!status && cal_mpi_rank() == 0) {
-        errors_against_reference(s);
+        errors_against_finest(s);
         status = write_csv(s, s->err, sizeof s->err) || write_markdown(s, command, exp_wall_seconds() - t0, s->err, sizeof s->err) ||
                  write_plots(s, s->err, sizeof s->err);
         if (!status) fprintf(stderr, "granucal study: wrote %s/fidelity.md and its CSV and plots\n", s->out);

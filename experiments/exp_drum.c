@@ -301,14 +301,18 @@ typedef struct turn_state {
     double t0, earlier_wall_s;
 } turn_state;
 
-enum { MEASURE_DOUBLES = 4, TURN_DOUBLES = 6 };
+enum { MEASURE_DOUBLES = 4 };
+// The slots of the checkpoint's "turn" array, one home for save and resume.
+enum { TURN_T0, TURN_STEPS, TURN_WALL_S, TURN_START_TILT, TURN_STEADY_FROM, TURN_STEADY_AT, TURN_DOUBLES };
 _Static_assert(sizeof(exp_drum_measure) == MEASURE_DOUBLES * sizeof(double), "a measurement is saved as 4 doubles");
 
 static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_state *s, double wall_s, char *err,
                      size_t len)
 {
-    double turn[TURN_DOUBLES] = {s->t0,           (double)s->steps,       s->earlier_wall_s + wall_s,
-                                 o->start_tilt_deg, (double)s->steady_from, (double)s->steady_at};
+    double turn[TURN_DOUBLES];
+    turn[TURN_T0] = s->t0, turn[TURN_STEPS] = (double)s->steps, turn[TURN_WALL_S] = s->earlier_wall_s + wall_s;
+    turn[TURN_START_TILT] = o->start_tilt_deg;
+    turn[TURN_STEADY_FROM] = s->steady_from, turn[TURN_STEADY_AT] = s->steady_at;
     dem_checkpoint_array extra[2] = {{"turn", turn, TURN_DOUBLES},
                                      {"measurements", (double *)s->m, (size_t)s->count * MEASURE_DOUBLES}};
     return dem_checkpoint_write(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, len);
@@ -324,9 +328,10 @@ static int resume_turn(dem_world *w, const exp_drum_run_opts *o, turn_state *s, 
     int ok = rc == 0 && extra[0].count == TURN_DOUBLES && extra[1].count % MEASURE_DOUBLES == 0 &&
              extra[1].count / MEASURE_DOUBLES <= (size_t)s->cap;
     if (ok) {
-        s->t0 = extra[0].data[0], s->steps = (uint64_t)extra[0].data[1], s->earlier_wall_s = extra[0].data[2];
-        out->start_tilt_deg = extra[0].data[3];
-        s->steady_from = (int)extra[0].data[4], s->steady_at = (int)extra[0].data[5];
+        const double *turn = extra[0].data;
+        s->t0 = turn[TURN_T0], s->steps = (uint64_t)turn[TURN_STEPS], s->earlier_wall_s = turn[TURN_WALL_S];
+        out->start_tilt_deg = turn[TURN_START_TILT];
+        s->steady_from = (int)turn[TURN_STEADY_FROM], s->steady_at = (int)turn[TURN_STEADY_AT];
         s->count = (int)(extra[1].count / MEASURE_DOUBLES);
         memcpy(s->m, extra[1].data, extra[1].count * sizeof(double));
     } else if (rc != 1)

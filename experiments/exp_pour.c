@@ -81,11 +81,16 @@ static int cell_of(const band_grid *g, dem_vec3 p, int *ix, int *iy, int *iz)
     return *ix >= 0 && *ix < g->nx && *iy >= 0 && *iy < g->ny && *iz >= 0 && *iz < g->nz;
 }
 
+static size_t cell_index(const band_grid *g, int ix, int iy, int iz)
+{
+    return ((size_t)iz * (size_t)g->ny + (size_t)iy) * (size_t)g->nx + (size_t)ix;
+}
+
 static void grid_insert(band_grid *g, dem_vec3 p, double r)
 {
     int ix, iy, iz;
     if (g->count == g->cap || !cell_of(g, p, &ix, &iy, &iz)) return; // outside the band: cannot touch it
-    size_t c = ((size_t)iz * (size_t)g->ny + (size_t)iy) * (size_t)g->nx + (size_t)ix;
+    size_t c = cell_index(g, ix, iy, iz);
     g->p[g->count] = p, g->r[g->count] = r, g->next[g->count] = g->head[c];
     g->head[c] = (int)g->count++;
 }
@@ -98,8 +103,7 @@ static int grid_overlaps(const band_grid *g, dem_vec3 p, double r)
         for (int iy = cy - 1; iy <= cy + 1; ++iy)
             for (int ix = cx - 1; ix <= cx + 1; ++ix) {
                 if (ix < 0 || iy < 0 || iz < 0 || ix >= g->nx || iy >= g->ny || iz >= g->nz) continue;
-                for (int k = g->head[((size_t)iz * (size_t)g->ny + (size_t)iy) * (size_t)g->nx + (size_t)ix]; k >= 0;
-                     k = g->next[k]) {
+                for (int k = g->head[cell_index(g, ix, iy, iz)]; k >= 0; k = g->next[k]) {
                     double reach = r + g->r[k];
                     if (dem_v3_norm2(dem_v3_sub(g->p[k], p)) < reach * reach) return 1;
                 }
@@ -147,7 +151,8 @@ size_t exp_pack_band(dem_world *w, const exp_pour_region *region, double floor_y
         int found = 0;
         dem_vec3 p;
         for (int t = 0; t < tries && !found; ++t) {
-            p = dem_v3(region->lo.x + (region->hi.x - region->lo.x) * gsl_rng_uniform(rng), y0 + r + (top - y0 - r) * gsl_rng_uniform(rng),
+            p = dem_v3(region->lo.x + (region->hi.x - region->lo.x) * gsl_rng_uniform(rng),
+                       y0 + r + (top - y0 - r) * gsl_rng_uniform(rng),
                        region->lo.z + (region->hi.z - region->lo.z) * gsl_rng_uniform(rng));
             found = region->inside(p, region->ctx) && !grid_overlaps(&g, p, r);
         }
