@@ -42,26 +42,40 @@ static void check_accepted(const cal_series *s, cal_data_kind kind, const char *
 
 /// Independent of libcsv: in a file without quotes every row is its commas
 /// plus one fields, so an accepted file must have exactly three commas on
-/// every line that is not blank or a '#' comment (the header included).
-/// Lines end at LF or at a lone CR, as libcsv ends its rows.
+/// every row (the header included). Rows as the loader sees them: a physical
+/// line (to LF) that is blank or a '#' comment after leading blanks and CRs
+/// is dropped whole, a CR inside it included; any other line goes to libcsv,
+/// which also ends a row at a lone CR and skips a row of blanks.
+static void check_row_commas(const uint8_t *data, size_t start, size_t end)
+{
+    size_t first = start;
+    while (first < end && (data[first] == ' ' || data[first] == '\t')) first++;
+    if (first == end) return;
+    int commas = 0;
+    for (size_t k = first; k < end; ++k) commas += data[k] == ',';
+    if (commas != 3) {
+        char detail[96];
+        snprintf(detail, sizeof detail, "a row at byte %zu has %d fields", start, commas + 1);
+        fuzz_violation("cal_series_load accepted a row whose field count is not the header's 4", detail);
+    }
+}
+
 static void check_field_counts(const uint8_t *data, size_t size)
 {
     if (memchr(data, '"', size)) return;
     size_t start = 0;
     while (start < size) {
-        size_t end = start;
-        while (end < size && data[end] != '\n' && data[end] != '\r') end++;
+        const uint8_t *lf = memchr(data + start, '\n', size - start);
+        size_t end = lf ? (size_t)(lf - data) : size;
         size_t first = start;
-        while (first < end && (data[first] == ' ' || data[first] == '\t')) first++;
-        if (first < end && data[first] != '#') {
-            int commas = 0;
-            for (size_t k = first; k < end; ++k) commas += data[k] == ',';
-            if (commas != 3) {
-                char detail[96];
-                snprintf(detail, sizeof detail, "a row at byte %zu has %d fields", start, commas + 1);
-                fuzz_violation("cal_series_load accepted a row whose field count is not the header's 4", detail);
+        while (first < end && (data[first] == ' ' || data[first] == '\t' || data[first] == '\r')) first++;
+        if (first < end && data[first] != '#')
+            for (size_t row = start; row <= end;) {
+                const uint8_t *cr = memchr(data + row, '\r', end - row);
+                size_t row_end = cr ? (size_t)(cr - data) : end;
+                check_row_commas(data, row, row_end);
+                row = row_end + 1;
             }
-        }
         start = end + 1;
     }
 }
