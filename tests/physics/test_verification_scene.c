@@ -24,10 +24,11 @@
 
 static char scene_path[1024];
 
+/// The scene as shipped, or with its lever arm replaced when `lever` is not NULL.
 static dem_world *build_variant(exp_scene *s, const char *lever, dem_damping_mode damping)
 {
     char *saved = s->lever_arm;
-    s->lever_arm = (char *)lever;
+    if (lever) s->lever_arm = (char *)lever;
     char err[512];
     dem_world *w = exp_scene_build(s, err, sizeof err);
     s->lever_arm = saved;
@@ -47,11 +48,18 @@ static double max3(const double a[3], dem_vec3 b)
     return fmax(fabs(a[0] - b.x), fmax(fabs(a[1] - b.y), fabs(a[2] - b.z)));
 }
 
+/// `lever` NULL runs the scene's own lever arm, which must then be the
+/// reference's `lever_option`.
 static void compare(const char *lever, int lever_option, dem_damping_mode damping)
 {
     char err[512];
     exp_scene *s = exp_scene_load(scene_path, err, sizeof err);
     if (!s) fail_msg("%s", err);
+    if (!lever) {
+        assert_non_null(s->lever_arm);
+        lever = s->lever_arm;
+        assert_int_equal(strcmp(lever, "radius") == 0 ? REF_LEVER_RADIUS : REF_LEVER_CONTACT_POINT, lever_option);
+    }
     dem_world *w = build_variant(s, lever, damping);
     ref_options opt = ref_default_options();
     opt.lever = lever_option;
@@ -84,31 +92,38 @@ static void compare(const char *lever, int lever_option, dem_damping_mode dampin
     exp_scene_free(s);
 }
 
-static void test_default_reading(void **state)
+/// Table A.1 as shipped: eq. 7 and 9's lever arm R_i, taken from the scene
+/// file itself (the paper's verification scene verifies the paper's equations).
+static void test_scene_as_shipped(void **state)
+{
+    (void)state;
+    compare(NULL, REF_LEVER_RADIUS, DEM_DAMPING_APPROACHING);
+}
+
+static void test_other_damping_readings(void **state)
+{
+    (void)state;
+    compare("radius", REF_LEVER_RADIUS, DEM_DAMPING_ALWAYS);
+    compare("radius", REF_LEVER_RADIUS, DEM_DAMPING_SEPARATING);
+    compare("radius", REF_LEVER_RADIUS, DEM_DAMPING_NO_TENSION);
+}
+
+/// The drum scenes' objective lever arm (contact point), every damping reading.
+static void test_contact_point_lever_arm(void **state)
 {
     (void)state;
     compare("contact_point", REF_LEVER_CONTACT_POINT, DEM_DAMPING_APPROACHING);
-}
-
-static void test_other_readings(void **state)
-{
-    (void)state;
     compare("contact_point", REF_LEVER_CONTACT_POINT, DEM_DAMPING_ALWAYS);
     compare("contact_point", REF_LEVER_CONTACT_POINT, DEM_DAMPING_SEPARATING);
     compare("contact_point", REF_LEVER_CONTACT_POINT, DEM_DAMPING_NO_TENSION);
-}
-
-static void test_literal_lever_arm(void **state)
-{
-    (void)state;
-    compare("radius", REF_LEVER_RADIUS, DEM_DAMPING_APPROACHING);
 }
 
 int main(void)
 {
     const char *src = getenv("GRANUCAL_SOURCE_DIR");
     snprintf(scene_path, sizeof scene_path, "%s/configs/scenes/verification_two_particles.yaml", src ? src : ".");
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_default_reading), cmocka_unit_test(test_other_readings),
-                                       cmocka_unit_test(test_literal_lever_arm)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_scene_as_shipped),
+                                       cmocka_unit_test(test_other_damping_readings),
+                                       cmocka_unit_test(test_contact_point_lever_arm)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
