@@ -57,6 +57,11 @@ static const char help[] =
     "                     0: none)\n"
     "  -h, --help         this text\n"
     "\n"
+    "Progress: one line per simulation on stderr, ending with the step of the whole\n"
+    "calibration (stiffness, granule, each wall material), the simulations done of the\n"
+    "most it may take, and the time left at most, from the measured cost of each kind of\n"
+    "simulation so far (stored ones included) shared by the simulations run at once.\n"
+    "\n"
     "Resuming: every simulation is stored in OUT/store under a hash of everything that\n"
     "defines it; run the same command again after a kill and nothing finished is rerun.\n"
     "A drum run killed while turning resumes from its last checkpoint (OUT/store/*.turn.h5)\n"
@@ -188,6 +193,7 @@ typedef struct run {
     cal_friction_result *granule, *walls[16];
     int n_walls;
     cal_table table;
+    cal_progress progress;
     char err[2048];
 } run;
 
@@ -319,11 +325,29 @@ static void print_table(const char *dir)
     printf("\nresults: %s (report.md, calibrated_parameters.csv, plots)\n", dir);
 }
 
+// Every stage this run will do, with the simulations it may take, so that
+// progress lines can say how far the whole calibration is and the time left.
+static void plan_progress(run *r)
+{
+    cal_progress *p = &r->progress;
+    cal_progress_init(p, r->env.workers * cal_mpi_size());
+    if (wants(r, "stiffness")) cal_progress_plan(p, "stiffness", CAL_RUN_CYLINDER, (int)r->c->stiffness_count * r->t->seeds);
+    if (wants(r, "granule"))
+        cal_progress_plan(p, "granule", CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, NULL));
+    for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if (!r->opt.material || strcasecmp(r->opt.material, m->name) == 0)
+            cal_progress_plan(p, m->name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
+    }
+    r->env.progress = p;
+}
+
 static int calibrate(run *r, const char *command)
 {
     double k_n, gg_mu_s, gg_mu_r;
     const char *k_source, *gg_source;
     r->env.started = exp_wall_seconds();
+    plan_progress(r);
     r->table.gg_mu_s_range = r->table.gg_mu_r_range = (cal_range){NAN, NAN, NAN, NAN}; // until stage 2 says
     if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
         stage_walls(r, k_n, gg_mu_s, gg_mu_r))

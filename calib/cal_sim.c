@@ -130,8 +130,15 @@ static void show_done(const cal_env *env, const char *what, const cal_record *r)
     else if (r->granules)
         fprintf(stderr, ", angle %.1f° ± %.1f, CSA %.1f %% ± %.1f", r->angle_deg, r->angle_sd_deg, r->csa_percent,
                 r->csa_sd_percent);
-    fprintf(stderr, " — %.2f s simulated in %.0f s; %.0f s elapsed\n", r->simulated_time_s, r->wall_time_s, wall);
+    char progress[160];
+    cal_progress_describe(env->progress, progress, sizeof progress);
+    fprintf(stderr, " — %.2f s simulated in %.0f s; %.0f s elapsed%s%s\n", r->simulated_time_s, r->wall_time_s, wall,
+            progress[0] ? "; " : "", progress);
 }
+
+// What a record's simulation cost to run: its turning or pouring, and the
+// settling charged to it.
+static double record_cost_s(const cal_record *r) { return r->wall_time_s + r->fill_wall_time_s; }
 
 // A record every rank must find once a batch is done.
 static int read_back(const cal_env *env, const char *key, cal_record *out, char *err, size_t len)
@@ -277,8 +284,8 @@ static int settle_and_turn(int i, void *ctx)
 }
 
 // A run ended: a process killed by a signal wrote nothing, so record it as
-// failed (unless its record was stored before); then show what it holds.
-static void finish_run(cal_env *env, const char *key, const char *what, int code)
+// failed (unless its record was stored before); then count it and show what it holds.
+static void finish_run(cal_env *env, cal_run_kind kind, const char *key, const char *what, int code)
 {
     char err[512];
     cal_record r;
@@ -292,9 +299,10 @@ static void finish_run(cal_env *env, const char *key, const char *what, int code
         write_failed_record(env, key, reason, outside);
     }
     if (cal_store_get(env->store, key, &r, err, sizeof err) == 0) {
+        cal_progress_count(env->progress, kind, record_cost_s(&r));
         show_done(env, what, &r);
         cal_record_free(&r);
-    }
+    } else cal_progress_count(env->progress, kind, NAN);
     env->simulations_run++;
 }
 
@@ -304,7 +312,7 @@ static void show_run(drum_batch *b, drum_run r, int code, int n_cases)
     const dem_contact_params *p = &b->cases[r.c].def.wall; // the granule stage's wall pair is its granule pair
     if (n_cases > 1) snprintf(what, sizeof what, "mu_s = %.4g, mu_r = %.4g, %g rpm", p->mu_s, p->mu_r, b->rpm[r.k]);
     else snprintf(what, sizeof what, "%g rpm", b->rpm[r.k]);
-    finish_run(b->env, run_key(b, r), what, code);
+    finish_run(b->env, CAL_RUN_DRUM, run_key(b, r), what, code);
 }
 
 static void turned(int i, int code, void *ctx)
@@ -390,6 +398,20 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
     if (b->n_case_todo > 0) cal_pool_run(b->n_case_todo, settle_and_turn, settled_and_turned, b, b->env->workers, b->env->use_fork);
 }
 
+// A record found in the store: a simulation done, at the cost it had; then released.
+static void count_stored(cal_env *env, cal_run_kind kind, cal_record *r)
+{
+    cal_progress_count(env->progress, kind, record_cost_s(r));
+    cal_record_free(r);
+}
+
+static int ran_here(const drum_batch *b, drum_run r)
+{
+    for (int i = 0; i < b->n_todo; ++i)
+        if (b->todo[i].c == r.c && b->todo[i].k == r.k) return 1;
+    return 0;
+}
+
 int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
                            cal_record *out, char *err, size_t len)
 {
@@ -409,12 +431,14 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
             int got = cal_store_get(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
             bad = got < 0;
             if (got == 1) missing[n_missing++] = (drum_run){c, k};
-            if (got == 0) cal_record_free(&out[c * n + k]);
+            if (got == 0) count_stored(env, CAL_RUN_DRUM, &out[c * n + k]);
         }
     if (!bad && n_missing > 0) run_missing_drum(&b, missing, n_missing);
     cal_mpi_barrier(); // every rank's records are on the shared store now
     int read = 0;
     while (!bad && read < runs) bad = read_back(env, b.keys[read], &out[read], err, len), read += !bad;
+    for (int i = 0; i < n_missing && !bad; ++i) // other ranks' runs
+        if (!ran_here(&b, missing[i])) cal_progress_count(env->progress, CAL_RUN_DRUM, record_cost_s(&out[missing[i].c * n + missing[i].k]));
     if (bad) // the caller gets no records: release those read
         while (read > 0) cal_record_free(&out[--read]);
     free(b.keys), free(b.todo), free(b.case_todo), free(missing);
@@ -464,27 +488,31 @@ static void poured(int i, int code, void *ctx)
     char what[96];
     snprintf(what, sizeof what, "cylinder k_n = %g N/m, seed %llu", b->cases[k].granule.k_n,
              (unsigned long long)b->cases[k].seed);
-    finish_run(b->env, b->keys[k], what, code);
+    finish_run(b->env, CAL_RUN_CYLINDER, b->keys[k], what, code);
 }
 
 int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len)
 {
     char(*keys)[2048] = calloc((size_t)n, sizeof *keys);
     int *todo = calloc((size_t)n, sizeof *todo), n_todo = 0, n_missing = 0, bad = 0;
-    if (!keys || !todo) return free(keys), free(todo), exp_fail(err, len, "out of memory"), 1;
+    char *missing = calloc((size_t)n, 1); // missing here and run by another rank
+    if (!keys || !todo || !missing) return free(keys), free(todo), free(missing), exp_fail(err, len, "out of memory"), 1;
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
         cal_cylinder_key(&cases[k], keys[k], sizeof keys[k]);
         int got = cal_store_get(env->store, keys[k], &out[k], err, len);
         bad = got < 0;
-        if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k;
-        if (got == 0) cal_record_free(&out[k]);
+        missing[k] = got == 1;
+        if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k, missing[k] = 0;
+        if (got == 0) count_stored(env, CAL_RUN_CYLINDER, &out[k]);
     }
     cylinder_batch b = {env, cases, todo, keys};
     if (!bad && n_todo > 0) cal_pool_run(n_todo, pour_one, poured, &b, env->workers, env->use_fork);
     cal_mpi_barrier();
-    for (int k = 0; k < n && !bad; ++k)
+    for (int k = 0; k < n && !bad; ++k) {
         bad = read_back(env, keys[k], &out[k], err, len);
-    free(keys), free(todo);
+        if (!bad && missing[k]) cal_progress_count(env->progress, CAL_RUN_CYLINDER, record_cost_s(&out[k])); // another rank's
+    }
+    free(keys), free(todo), free(missing);
     return bad;
 }

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "cal_config.h"
+#include "cal_progress.h"
 #include "cal_store.h"
 #include "exp_cylinder.h"
 #include "exp_drum.h"
@@ -26,6 +27,7 @@ typedef struct cal_env {
     /// a killed run, run again, resumes its turn from the last one.
     double checkpoint_every_s;
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
+    cal_progress *progress;             ///< the whole calibration's, or NULL (a study, a single run)
 } cal_env;
 
 /// Default wall seconds between a drum run's checkpoints: a kill costs at

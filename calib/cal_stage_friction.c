@@ -105,11 +105,13 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
     cal_candidate_score(r, k);
 }
 
+// Candidates the stage evaluates at most: the grid, COBYLA's, the bound probes.
+static int planned_candidates(const cal_tier *t) { return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0); }
+
 // "candidate i of at most N" (or "candidates i-j"), with the time left at the pace so far.
 static void show_start(const search *s, const double (*mu)[2], int m)
 {
-    int probes = cal_tier_bound_probes(s->t) ? 2 : 0;
-    int planned = s->t->grid * s->t->grid + s->t->max_evaluations + probes, done = s->r->n;
+    int planned = planned_candidates(s->t), done = s->r->n;
     double spent = exp_wall_seconds() - s->started;
     char eta[48] = "", which[32];
     if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
@@ -374,6 +376,19 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     return 0;
 }
 
+int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
+                              const cal_series *areas, const cal_material *material)
+{
+    cal_friction_result *r = calloc(1, sizeof *r);
+    char err[512];
+    if (!r) return -1;
+    snprintf(r->surface, sizeof r->surface, "%s", material ? material->surface : c->granule_surface);
+    search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = sizeof err};
+    int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t);
+    free(r);
+    return runs;
+}
+
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, char *err, size_t len)
@@ -387,6 +402,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     static char stage[64];
     snprintf(stage, sizeof stage, "%s", material ? material->name : "granule");
     env->stage = stage;
+    cal_progress_enter(env->progress, stage);
     search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
     if (set_targets(&s, angles, areas)) return 1;
     evaluate_grid(&s);

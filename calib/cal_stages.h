@@ -98,6 +98,12 @@ int cal_friction_best(const cal_friction_result *r);
 /// tell from the best; μs and μr range over those. Needs csa_tier_sd set.
 void cal_friction_identify(cal_friction_result *r);
 
+/// The drum runs stage 2 (material == NULL) or 3 may take at most: its
+/// speeds times (grid points + COBYLA's evaluations + bound probes); -1 if
+/// the data lack the stage's surface (the stage itself then says why).
+int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
+                              const cal_series *areas, const cal_material *material);
+
 /// Stage 2 (material == NULL) or 3 (a material of the config).
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
