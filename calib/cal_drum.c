@@ -31,17 +31,19 @@ static void show_progress(const char *phase, double t, size_t granules, void *ct
 
 static void write_json(FILE *f, const exp_drum_yaml *y, const exp_drum_result *r, const dem_world *w, const char *status)
 {
-    char effects[1024];
+    char effects[1024], margin[32];
     dem_world_describe_features(w, effects, sizeof effects);
+    snprintf(margin, sizeof margin, isnan(r->dt_margin_min) ? "null" : "%.4f", r->dt_margin_min); // JSON has no NaN
     fprintf(f,
             "{\"experiment\": \"drum\", \"status\": \"%s\", \"rpm\": %g, \"wall\": \"%s\", \"mu_s\": %g, \"mu_r\": %g, "
             "\"k_n\": %g, \"lambda\": %g, \"seed\": %d, \"angle_deg\": %.4f, \"angle_sd_deg\": %.4f, "
             "\"csa_percent\": %.4f, \"csa_sd_percent\": %.4f, \"surface_fit_sd_m\": %.4g, \"steady\": %s, "
             "\"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"granules\": %zu, \"particle_steps\": %llu, "
-            "\"dt_s\": %.6g, \"start_tilt_deg\": %g, \"effects\": \"%s\"}\n",
+            "\"dt_s\": %.6g, \"dt_margin_min\": %s, \"dt_lowered\": %d, \"start_tilt_deg\": %g, \"effects\": \"%s\"}\n",
             status, y->rpm, y->wall, y->mu_s, y->mu_r, y->k_n, y->lambda, y->seed, r->angle_deg, r->angle_sd_deg,
             r->csa_percent, r->csa_sd_percent, r->fit_sd_m, r->steady ? "true" : "false", r->simulated_time_s,
-            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w), r->start_tilt_deg, effects);
+            r->wall_time_s, r->granules, r->particle_steps, dem_world_dt(w), margin, r->dt_lowered, r->start_tilt_deg,
+            effects);
 }
 
 static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *r, const dem_world *w,

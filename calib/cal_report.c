@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cal_plot.h"
+#include "cal_figures.h"
 #include "cal_util.h"
 #include "dem_gsd.h"
 #include "exp_common.h"
@@ -323,71 +323,6 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
     return cal_atomic_commit(&a, err, len);
 }
 
-// ---- plots -------------------------------------------------------------------------
-
-static int plot_stiffness(const char *dir, const cal_stiffness_result *s, char *err, size_t len)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/cn_vs_k.png", dir);
-    cal_chart c = {.title = "Stage 1: coordination number of the poured cylinder (Fig. 12)",
-                   .xlabel = "granule stiffness k_n (N/m, real powder)", .ylabel = "coordination number (granule-granule)",
-                   .log_x = 1, .hline = s->stiff_limit - s->tolerance, .hline_label = "stiff limit - tolerance"};
-    c.series[c.n_series++] = (cal_series_xy){"mean over seeds (bars: sd)", s->k, s->cn_mean, s->cn_sd, s->n, 1, 1, 0.1, 0.3, 0.8};
-    double kx[1] = {s->chosen_k}, ky[1] = {NAN};
-    for (int i = 0; i < s->n; ++i)
-        if (s->k[i] == s->chosen_k) ky[0] = s->cn_mean[i];
-    c.series[c.n_series++] = (cal_series_xy){"chosen k_n", kx, ky, NULL, 1, 0, 1, 0.9, 0.1, 0.1};
-    return cal_plot_chart(path, &c, err, len);
-}
-
-static int plot_friction(const char *dir, const cal_outcome *o, const cal_friction_result *r, char *err, size_t len)
-{
-    const char *stage = r->material[0] ? r->material : "granule";
-    const cal_bounds *b = r->material[0] ? &o->config->wall : &o->config->granule;
-    double mu_s[CAL_MAX_EVALS], mu_r[CAL_MAX_EVALS], angle[CAL_MAX_EVALS], misfit[CAL_MAX_EVALS], best[CAL_MAX_EVALS],
-        index[CAL_MAX_EVALS];
-    double running = HUGE_VAL;
-    for (int i = 0; i < r->n; ++i) {
-        mu_s[i] = r->cand[i].mu_s, mu_r[i] = r->cand[i].mu_r, angle[i] = r->cand[i].angle_deg;
-        misfit[i] = r->cand[i].objective, index[i] = i + 1;
-        if (r->angle_in_misfit || r->cand[i].angle_violation <= 0) running = fmin(running, misfit[i]);
-        best[i] = isfinite(running) ? running : NAN;
-    }
-    char path[1200], title[160];
-    snprintf(path, sizeof path, "%s/angle_map_%s.png", dir, stage);
-    snprintf(title, sizeof title, "%s: dynamic angle of repose at %g rpm (Fig. %s)", stage, r->angle_rpm,
-             r->material[0] ? "17" : "13");
-    if (cal_plot_angle_map(path, title, mu_s, mu_r, angle, r->n, o->tier->grid, r->angle_target, r->angle_tolerance,
-                           r->best, b->mu_s_min, b->mu_s_max, b->mu_r_min, b->mu_r_max, err, len))
-        return 1;
-    snprintf(path, sizeof path, "%s/convergence_%s.png", dir, stage);
-    cal_chart conv = {.title = "search convergence", .xlabel = "evaluation",
-                      .ylabel = r->angle_in_misfit ? "angle and CSA misfit (mean squared z)" : "CSA misfit (mean squared z)",
-                      .log_y = 1, .hline = NAN};
-    conv.series[conv.n_series++] = (cal_series_xy){"each candidate", index, misfit, NULL, r->n, 0, 1, 0.5, 0.5, 0.5};
-    conv.series[conv.n_series++] = (cal_series_xy){r->angle_in_misfit ? "best so far" : "best matching the angle", index,
-                                                   best, NULL, r->n, 1, 0, 0.8, 0.1, 0.1};
-    if (cal_plot_chart(path, &conv, err, len)) return 1;
-    // CSA curves: the data, the chosen pair, and other pairs matching the angle (Fig. 16, 19).
-    snprintf(path, sizeof path, "%s/csa_vs_rpm_%s.png", dir, stage);
-    snprintf(title, sizeof title, "%s: occupied cross-section area (Fig. %s)", stage, r->material[0] ? "19" : "16");
-    cal_chart c = {.title = title, .xlabel = "drum speed (rpm)", .ylabel = "CSA (%)", .hline = NAN};
-    c.series[c.n_series++] = (cal_series_xy){"lab data", r->rpm, r->csa_data, r->csa_data_sd, r->n_rpm, 0, 1, 0, 0, 0};
-    static char labels[CAL_PLOT_MAX_SERIES][64];
-    double palette[5][3] = {{0.85, 0.1, 0.1}, {0.1, 0.4, 0.85}, {0.1, 0.6, 0.2}, {0.6, 0.2, 0.7}, {0.9, 0.5, 0.0}};
-    int shown = 0;
-    for (int pass = 0; pass < 2; ++pass)
-        for (int i = 0; i < r->n && c.n_series < 7; ++i) {
-            int chosen = i == r->best, matching = r->cand[i].angle_violation <= 0;
-            if ((pass == 0) != chosen || (pass == 1 && !matching)) continue;
-            snprintf(labels[c.n_series], 64, "%s%.3g / %.3g", chosen ? "chosen " : "", r->cand[i].mu_s, r->cand[i].mu_r);
-            const double *col = palette[shown++ % 5];
-            c.series[c.n_series++] = (cal_series_xy){labels[c.n_series], r->rpm, r->cand[i].csa, r->cand[i].csa_sd,
-                                                     r->n_rpm, 1, 1, col[0], col[1], col[2]};
-        }
-    return cal_plot_chart(path, &c, err, len);
-}
-
 // ---- report -------------------------------------------------------------------------
 
 // One end of an identified range: at the search bound, bracketed by an
@@ -523,9 +458,9 @@ int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t le
         write_table_h5(dir, rows, n, err, len) || write_liggghts(dir, o, err, len) || write_lammps(dir, o, err, len) ||
         write_simulations(dir, store, o, err, len) || write_report(dir, o, err, len))
         return 1;
-    if (o->stiffness && isfinite(o->stiffness->chosen_k) && plot_stiffness(dir, o->stiffness, err, len)) return 1;
-    if (o->granule && plot_friction(dir, o, o->granule, err, len)) return 1;
+    if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
+    if (o->granule && cal_figures_friction(dir, &o->config->granule, o->granule, err, len)) return 1;
     for (int w = 0; w < o->n_walls; ++w)
-        if (plot_friction(dir, o, o->walls[w], err, len)) return 1;
+        if (cal_figures_friction(dir, &o->config->wall, o->walls[w], err, len)) return 1;
     return 0;
 }

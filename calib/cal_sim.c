@@ -249,6 +249,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     rec.fill_wall_time_s = fill_s;
     rec.peak_rss_mb = exp_peak_rss_mb();
     rec.dt_s = dem_world_dt(w), rec.particle_steps = (double)res.particle_steps, rec.granules = (int)res.granules;
+    rec.dt_margin_min = res.dt_margin_min, rec.dt_lowered = res.dt_lowered;
     char err[512];
     int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);

@@ -5,6 +5,7 @@
 #include <cyaml/cyaml.h>
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,7 @@ static const cyaml_schema_field_t record_fields[] = {
     CYAML_FIELD_BOOL("steady", CYAML_FLAG_OPTIONAL, cal_record, steady), REC_FLOAT("simulated_time_s", simulated_time_s),
     REC_FLOAT("wall_time_s", wall_time_s), REC_FLOAT("dt_s", dt_s), REC_FLOAT("particle_steps", particle_steps),
     REC_FLOAT("fill_wall_time_s", fill_wall_time_s), REC_FLOAT("peak_rss_mb", peak_rss_mb),
+    REC_FLOAT("dt_margin_min", dt_margin_min), CYAML_FIELD_INT("dt_lowered", CYAML_FLAG_OPTIONAL, cal_record, dt_lowered),
     CYAML_FIELD_BOOL("retry", CYAML_FLAG_OPTIONAL, cal_record, retry),
     CYAML_FIELD_STRING_PTR("writer", CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, cal_record, writer, 0, 256),
     CYAML_FIELD_INT("granules", CYAML_FLAG_OPTIONAL, cal_record, granules), CYAML_FIELD_END};
@@ -106,11 +108,12 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
             "angle_deg: %.17g\nangle_sd_deg: %.17g\ncsa_percent: %.17g\ncsa_sd_percent: %.17g\n"
             "coordination: %.17g\ncoordination_interior: %.17g\nwall_contacts_per_granule: %.17g\n"
             "solid_fraction: %.17g\nsteady: %s\nsimulated_time_s: %.17g\nwall_time_s: %.6g\ndt_s: %.17g\n"
-            "particle_steps: %.17g\nfill_wall_time_s: %.6g\npeak_rss_mb: %.6g\ngranules: %d\n",
+            "particle_steps: %.17g\nfill_wall_time_s: %.6g\npeak_rss_mb: %.6g\ndt_margin_min: %.6g\ndt_lowered: %d\n"
+            "granules: %d\n",
             r->angle_deg, r->angle_sd_deg, r->csa_percent, r->csa_sd_percent, r->coordination,
             r->coordination_interior, r->wall_contacts_per_granule, r->solid_fraction, r->steady ? "true" : "false",
             r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->fill_wall_time_s, r->peak_rss_mb,
-            r->granules);
+            isfinite(r->dt_margin_min) ? r->dt_margin_min : 0, r->dt_lowered, r->granules); // YAML 0, not nan: unchecked
     return cal_atomic_commit(&a, err, len);
 }
 

@@ -22,6 +22,11 @@ typedef struct cal_record {
     double simulated_time_s, wall_time_s, dt_s, particle_steps;
     double fill_wall_time_s; ///< settling the bed, charged to the first speed turned from it (else 0)
     double peak_rss_mb;      ///< peak resident memory of the process that ran it
+    /// A drum turn's smallest network limit over its step, from its checks
+    /// (exp_drum_result.dt_margin_min; 0: not checked, or a record older than
+    /// the checks), and how often a check lowered the step.
+    double dt_margin_min;
+    int dt_lowered;
     int granules;
     int retry;               ///< a failure of the process, not of the simulation (killed from
                              ///< outside): valid for the run that wrote it, rerun by any later one

@@ -14,10 +14,10 @@
 
 #include "cal_commands.h"
 #include "cal_mpi.h"
-#include "cal_plot.h"
 #include "cal_sim.h"
 #include "cal_util.h"
 #include "exp_common.h"
+#include "exp_plot.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -435,36 +435,82 @@ static int write_markdown(const study *s, const char *command, double wall, char
     return cal_atomic_commit(&a, err, len);
 }
 
-static int write_plots(const study *s, char *err, size_t len)
+// Each rung run, in the order of the ladder: what the two figures plot.
+typedef struct rung_points {
+    int n;
+    double cost[MAX_RUNGS], angle_error[MAX_RUNGS], csa_error[MAX_RUNGS]; ///< all but the finest
+    const char *name[MAX_RUNGS];
+    int m;
+    double lambda[MAX_RUNGS], angle[MAX_RUNGS], angle_sd[MAX_RUNGS], csa[MAX_RUNGS], csa_sd[MAX_RUNGS];
+    const char *rung_of[MAX_RUNGS];
+} rung_points;
+
+static void collect_rungs(const study *s, rung_points *p)
 {
-    double cost[MAX_RUNGS], ae[MAX_RUNGS], ce[MAX_RUNGS], lam[MAX_RUNGS], ang[MAX_RUNGS], ang_sd[MAX_RUNGS];
-    double csa[MAX_RUNGS], csa_sd[MAX_RUNGS];
-    int n = 0, m = 0;
+    p->n = p->m = 0;
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
         if (!r->ran) continue;
-        lam[m] = r->rung->lambda, ang[m] = r->angle[0], ang_sd[m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
-        csa[m] = r->csa[0], csa_sd[m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0, m++;
+        p->lambda[p->m] = r->rung->lambda, p->angle[p->m] = r->angle[0], p->csa[p->m] = r->csa[0];
+        p->angle_sd[p->m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
+        p->csa_sd[p->m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0;
+        p->rung_of[p->m++] = r->rung->name;
         if (i == s->finest) continue; // its error is zero by definition
-        cost[n] = r->wall_s, ae[n] = r->angle_error, ce[n] = r->csa_error, n++;
+        p->cost[p->n] = r->wall_s, p->angle_error[p->n] = r->angle_error, p->csa_error[p->n] = r->csa_error;
+        p->name[p->n++] = r->rung->name;
     }
-    char path[1200];
-    cal_chart c = {.title = "Error against the finest rung vs wall time", .xlabel = "wall time of the rung (s)",
-                   .ylabel = "error (° for the angle, % for the CSA)", .log_x = 1, .hline = NAN};
-    c.series[c.n_series++] = (cal_series_xy){"angle error (°)", cost, ae, NULL, n, 0, 1, 0.8, 0.2, 0.1};
-    c.series[c.n_series++] = (cal_series_xy){"CSA rms error (%)", cost, ce, NULL, n, 0, 1, 0.1, 0.3, 0.8};
+}
+
+// What accuracy costs: each rung's errors against the finest at its wall
+// time, the rung named beside its angle point.
+static int plot_error_vs_cost(const study *s, const rung_points *p, char *err, size_t len)
+{
+    char path[1200], title[160];
     snprintf(path, sizeof path, "%s/fidelity_error_vs_cost.png", s->out);
-    if (n > 0 && cal_plot_chart(path, &c, err, len)) return 1;
+    snprintf(title, sizeof title, "What accuracy costs: error against the finest rung (%s)",
+             s->finest >= 0 ? s->res[s->finest].rung->name : "none");
+    exp_plot_series v[2] = {
+        {.n = (size_t)p->n, .x = p->cost, .y = p->angle_error, .names = p->name, .label = "angle error (°)",
+         .rgb = {0.84, 0.15, 0.16}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_CIRCLE},
+        {.n = (size_t)p->n, .x = p->cost, .y = p->csa_error, .label = "CSA rms error over the speeds (%)",
+         .rgb = {0.12, 0.40, 0.75}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_SQUARE},
+    };
+    exp_plot_axes axes = {.title = title, .xlabel = "wall time of the rung (s)",
+                          .ylabel = "error (° for the angle, % for the CSA)", .log_x = 1};
+    return exp_plot_png(path, &axes, 2, v, 1000, 640, err, len);
+}
+
+// The first speed's angle and CSA against λ, beside the paper's Table B.1.
+static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_t len)
+{
     double b1_l[3], b1_a[3], b1_c[3];
-    for (int k = 0; k < 3; ++k) b1_l[k] = table_b1[k].lambda, b1_a[k] = table_b1[k].angle_deg, b1_c[k] = table_b1[k].csa_percent;
-    cal_chart v = {.title = "Angle and CSA against the scale factor (first speed)", .xlabel = "scale factor λ",
-                   .ylabel = "angle (°) / CSA (%)", .log_x = 1, .hline = NAN};
-    v.series[v.n_series++] = (cal_series_xy){"angle, granucal (± seeds)", lam, ang, ang_sd, m, 0, 1, 0.8, 0.2, 0.1};
-    v.series[v.n_series++] = (cal_series_xy){"CSA, granucal (± seeds)", lam, csa, csa_sd, m, 0, 1, 0.1, 0.3, 0.8};
-    v.series[v.n_series++] = (cal_series_xy){"angle, Table B.1", b1_l, b1_a, NULL, 3, 1, 1, 0.9, 0.6, 0.5};
-    v.series[v.n_series++] = (cal_series_xy){"CSA, Table B.1", b1_l, b1_c, NULL, 3, 1, 1, 0.5, 0.6, 0.9};
+    for (int k = 0; k < 3; ++k)
+        b1_l[k] = table_b1[k].lambda, b1_a[k] = table_b1[k].angle_deg, b1_c[k] = table_b1[k].csa_percent;
+    size_t m = (size_t)p->m;
+    exp_plot_series v[4] = {
+        {.n = m, .x = p->lambda, .y = p->angle, .err = p->angle_sd, .names = p->rung_of,
+         .label = "angle, granucal (bars: seed sd)",
+         .rgb = {0.84, 0.15, 0.16}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_CIRCLE},
+        {.n = m, .x = p->lambda, .y = p->csa, .err = p->csa_sd, .label = "CSA, granucal (bars: seed sd)",
+         .rgb = {0.12, 0.40, 0.75}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_SQUARE},
+        {.n = 3, .x = b1_l, .y = b1_a, .label = "angle, paper's Table B.1", .rgb = {0.95, 0.6, 0.5},
+         .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_TRIANGLE, .dashed = 1},
+        {.n = 3, .x = b1_l, .y = b1_c, .label = "CSA, paper's Table B.1", .rgb = {0.5, 0.65, 0.95},
+         .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_DIAMOND, .dashed = 1},
+    };
+    char path[1200], title[160];
     snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->out);
-    return m > 0 && cal_plot_chart(path, &v, err, len);
+    snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", s->c->fidelity->rpm[0]);
+    exp_plot_axes axes = {.title = title, .xlabel = "scale factor λ", .ylabel = "angle (°) / CSA (%)", .log_x = 1};
+    return exp_plot_png(path, &axes, 4, v, 1000, 640, err, len);
+}
+
+static int write_plots(const study *s, char *err, size_t len)
+{
+    rung_points p;
+    collect_rungs(s, &p);
+    if (p.n > 0 && plot_error_vs_cost(s, &p, err, len)) return 1;
+    return p.m > 0 && plot_vs_lambda(s, &p, err, len);
 }
 
 // Run each wanted rung that fits the budget, in config order.

@@ -407,6 +407,23 @@ dem_status dem_world_adopt_network_dt(dem_world *w)
     return DEM_OK;
 }
 
+dem_status dem_world_check_network_dt(dem_world *w, dem_network_dt_check *out)
+{
+    *out = (dem_network_dt_check){NAN, 0};
+    // Building the list here would rebuild it at another moment than the
+    // steps do, and change the order forces are summed in.
+    if (!w->list_valid || w->dt <= 0) return DEM_OK;
+    dem_stability net = dem_stability_current(w);
+    if (!(net.dt_limit > 0) || !isfinite(net.dt_limit)) return out->margin = INFINITY, DEM_OK;
+    out->margin = net.dt_limit / w->dt;
+    if (out->margin >= 1) return DEM_OK;
+    dem_status st = apply_limit(w, &net, "current contact network (checked while running)");
+    if (st != DEM_OK) return st;
+    w->forces_valid = 0;
+    out->lowered = 1;
+    return DEM_OK;
+}
+
 // How the kicks find the rates: explicitly from F/m, with the implicit
 // dashpot, or from the implicit spring solve (dem_implicit_solve).
 typedef enum { KICK_EXPLICIT, KICK_IMPLICIT_DAMPING, KICK_IMPLICIT_SPRINGS } kick_mode;

@@ -159,6 +159,24 @@ dem_status dem_world_prepare(dem_world *w);
 /// returns DEM_ERR_UNSTABLE if a configured step is above it.
 dem_status dem_world_adopt_network_dt(dem_world *w);
 
+/// A network step checked again while the world runs (a turning bed's
+/// contacts change): the current network's limit over the step in use
+/// (> 1: stable with room to spare; INFINITY without contacts), and whether
+/// the step was lowered.
+typedef struct dem_network_dt_check {
+    double margin;
+    int lowered;
+} dem_network_dt_check;
+
+/// Check the step against the stability limit of the CURRENT contact network
+/// (dem_stability_current). Reads the world only, when the step is within
+/// the limit: a run checked is the same run, bit for bit. Above it, a step
+/// the engine chose is lowered to dt_safety of the new limit (lowered = 1).
+/// (A configured step passed the a-priori bound of the densest cluster, which
+/// no network exceeds, unless allow_unstable_dt let it through unchecked.)
+/// A world whose neighbour list is not built yet is not checked (margin NAN).
+dem_status dem_world_check_network_dt(dem_world *w, dem_network_dt_check *out);
+
 /// Advance `steps` time steps. Stops early with a status on a fault (NaN,
 /// escaped granule); the state at the fault is kept for inspection.
 dem_status dem_world_step(dem_world *w, uint64_t steps);

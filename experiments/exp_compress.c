@@ -362,11 +362,12 @@ int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path,
                 x[used] = 1e3 * r->curve[k].displacement, y[used++] = r->curve[k].f_top;
         if (used == first) continue;
         snprintf(labels[ns], sizeof labels[ns], "cycle %d", c);
-        series[ns] = (exp_plot_series){used - first, x + first, y + first, labels[ns], {0, 0, 0}, 0};
+        series[ns] = (exp_plot_series){.n = used - first, .x = x + first, .y = y + first, .label = labels[ns]};
         exp_plot_colour(c - 1, series[ns].rgb);
         ns++;
     }
-    exp_plot_axes ax = {"Confined compression: force on the piston", "piston displacement (mm)", "force (N)", 0, 0, 0, 0, 0};
+    exp_plot_axes ax = {.title = "Confined compression: force on the piston", .xlabel = "piston displacement (mm)",
+                        .ylabel = "force (N)"};
     int rc = exp_plot_png(png_path, &ax, (size_t)ns, series, 900, 600, err, len);
     free(x), free(y), free(series), free(labels);
     return rc;

@@ -2,6 +2,7 @@
 // The rotating drum: build, pour, settle, measure.
 #include "exp_drum.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -248,7 +249,7 @@ exp_drum_run_opts exp_default_drum_run_opts(void)
 {
     return (exp_drum_run_opts){.rpm = 4, .max_time = 6, .sample_interval = 0.05, .window = 1.0,
                                .angle_tol_deg = 1.0, .csa_tol_percent = 0.5, .adopt_network_dt = 1,
-                               .start_tilt_deg = 20.0, .average_time = 0};
+                               .start_tilt_deg = 20.0, .average_time = 0, .network_check_interval = 0.5};
 }
 
 dem_status exp_drum_tilt(dem_world *w, double degrees)
@@ -365,6 +366,24 @@ static dem_status start_turn(dem_world *w, const exp_drum_def *d, const exp_drum
     return DEM_OK;
 }
 
+// Every network_check_interval of turning (counted in samples, which a
+// resumed run counts on from its checkpoint: the checks fall where they would
+// have), the step against the bed's network now; a lowered step changes the
+// steps per sample (*chunk).
+static dem_status check_step(dem_world *w, const exp_drum_run_opts *o, int samples, uint64_t *chunk,
+                             exp_drum_result *out)
+{
+    int every = (int)(o->network_check_interval / o->sample_interval + 0.5);
+    if (!(o->network_check_interval > 0) || samples % (every > 0 ? every : 1) != 0) return DEM_OK;
+    double t0 = exp_wall_seconds();
+    dem_network_dt_check c;
+    dem_status st = dem_world_check_network_dt(w, &c);
+    out->network_check_wall_s += exp_wall_seconds() - t0;
+    if (!isnan(c.margin)) out->dt_margin_min = isnan(out->dt_margin_min) ? c.margin : fmin(out->dt_margin_min, c.margin);
+    if (c.lowered) out->dt_lowered++, *chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
+    return st;
+}
+
 dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
                            void *ctx, exp_drum_result *out)
 {
@@ -380,6 +399,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     out->earlier_wall_s = s.earlier_wall_s;
     uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
+    out->dt_margin_min = NAN;
     while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval &&
            !(s.steady_from >= 0 && s.count - s.steady_at >= avg_samples)) {
         st = dem_world_step(w, chunk);
@@ -390,6 +410,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
         out->measure_wall_s += exp_wall_seconds() - measure_start;
         if (unmeasured) break;
         s.count++;
+        if ((st = check_step(w, o, s.count, &chunk, out)) != DEM_OK) break;
         if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
             s.steady_from = s.count - 2 * per_window, s.steady_at = s.count;
         if (progress) progress("turn", dem_world_time(w) - s.t0, dem_world_granules(w).count, ctx);

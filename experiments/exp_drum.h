@@ -93,6 +93,10 @@ typedef struct exp_drum_run_opts {
     double angle_tol_deg;   ///< steady: window means of the angle agree within this (1.0°) + half their mean sd
     double csa_tol_percent; ///< ... and of the CSA within this (0.5 %) + half their mean sd
     int adopt_network_dt;   ///< turn at the settled bed's own network step limit (1)
+    /// s of turning between checks of the step against the turning bed's
+    /// own network (dem_world_check_network_dt; 0: never). A check reads the
+    /// bed only, so a run whose step stays within the limit is the same run.
+    double network_check_interval;
     /// The settled bed is first turned rigidly by this angle about the drum
     /// axis, in the drum's sense (20°): as if the drum had already turned it,
     /// which a real drum does before it avalanches. Saves the rigid turn a
@@ -129,6 +133,12 @@ typedef struct exp_drum_result {
     double earlier_wall_s;
     double averaged_time_s;      ///< s of turning the means and spreads are over
     double measure_wall_s;       ///< wall seconds of this call spent measuring the drum face
+    /// The smallest network limit over the step seen by the checks of this
+    /// call (NAN: none made), how often the step had to be lowered, and the
+    /// wall seconds the checks took.
+    double dt_margin_min;
+    int dt_lowered;
+    double network_check_wall_s;
     int resumed;                 ///< 1: resumed from a checkpoint
     char checkpoint_note[512];   ///< why a checkpoint found was not resumed, else ""
     unsigned long long particle_steps;

@@ -1,13 +1,29 @@
 // SPDX-License-Identifier: MIT
-// Line plots to PNG with cairo.
+// Figures as PNG, drawn by PLplot's pngcairo device (see exp_plot.h).
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L // gethostname, getpid: also when compiled alone (compare_silo.sh)
+#endif
 #include "exp_plot.h"
 
-#include "dem_vec.h"
-
-#include <cairo.h>
+#include <errno.h>
 #include <math.h>
+#include <plplot.h>
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+// The module stands alone (tests/peers/compare_silo.sh compiles it with one
+// program): its own message helper rather than exp_common's.
+__attribute__((format(printf, 3, 4))) static int fail(char *err, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, len, fmt, ap);
+    va_end(ap);
+    return 1;
+}
 
 void exp_plot_colour(int k, double rgb[3])
 {
@@ -17,136 +33,753 @@ void exp_plot_colour(int k, double rgb[3])
     memcpy(rgb, palette[((k % 8) + 8) % 8], 3 * sizeof(double));
 }
 
-// A "nice" tick step of about range/6 (1, 2 or 5 times a power of ten).
-static double tick_step(double range)
+// ---- one figure: begun and ended in one call -------------------------------------
+
+// Character scales: axis text, the title, and the small text (legend, point
+// names, colour bar), relative to a character height of TEXT_MM.
+static const double TEXT = 1.0, TITLE = 1.25, SMALL = 0.9, TEXT_MM = 5.0;
+
+// PLplot scales its default character with the page; granucal's text keeps
+// one size in pixels whatever the figure's size (set per figure).
+static double text_base = 1;
+
+static void text_size(double scale)
 {
-    double raw = range / 6.0, p = pow(10.0, floor(log10(raw))), f = raw / p;
-    return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * p;
+    plschr(0, text_base * scale);
 }
 
-static void data_range(size_t ns, const exp_plot_series *s, int y, int log_y, double *lo, double *hi)
+// cmap0 slots: 0 background, 1 ink, 2 grid, 3 white, then one per series.
+enum { INK = 1, GRID_GREY = 2, WHITE = 3, FIRST_SERIES_COLOUR = 4, N_COLOURS = 64 };
+
+typedef struct figure {
+    const char *path;
+    char tmp[1300];
+    char plplot_error[256]; ///< PLplot's first complaint during the figure ("" if none)
+} figure;
+
+// PLplot reports recoverable errors through its abort handler, a process-wide
+// function pointer: this records the first one of the figure being drawn.
+static figure *drawing;
+
+static void record_plplot_error(const char *message)
 {
-    *lo = INFINITY, *hi = -INFINITY;
+    if (drawing && !drawing->plplot_error[0])
+        snprintf(drawing->plplot_error, sizeof drawing->plplot_error, "%s", message);
+}
+
+// Without the driver plinit would ask on stdin for another device: check first.
+static int have_pngcairo(void)
+{
+    enum { MAX_DEVICES = 128 };
+    const char *menu_storage[MAX_DEVICES], *name_storage[MAX_DEVICES];
+    const char **menu = menu_storage, **names = name_storage;
+    int n = MAX_DEVICES; // in: room in the arrays; out: devices listed
+    plgDevs(&menu, &names, &n);
+    for (int k = 0; k < n; ++k)
+        if (!strcmp(names[k], "pngcairo")) return 1;
+    return 0;
+}
+
+// Our own temporary, opened here so that an unwritable path is an error we
+// report (PLplot would prompt for another name, then exit). Named as
+// calib's atomic files are (path.host.pid.tmp): a sweep of a dead run's
+// temporaries finds these too.
+static int open_temporary(figure *f, FILE **out, char *err, size_t len)
+{
+    char host[64] = "host";
+    gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = 0;
+    snprintf(f->tmp, sizeof f->tmp, "%s.%s.%ld.tmp", f->path, host, (long)getpid());
+    *out = fopen(f->tmp, "wb");
+    if (!*out) return fail(err, len, "%s: cannot write the plot (%s)", f->path, strerror(errno));
+    return 0;
+}
+
+static int begin_figure(figure *f, const char *path, int width, int height, char *err, size_t len)
+{
+    memset(f, 0, sizeof *f);
+    f->path = path;
+    if (!have_pngcairo())
+        return fail(err, len, "%s: PLplot has no pngcairo device (install plplot-driver-cairo)", path);
+    FILE *png = NULL;
+    if (open_temporary(f, &png, err, len)) return 1;
+    PLINT stream;
+    plmkstrm(&stream);
+    plsdev("pngcairo");
+    plsfile(png); // PLplot closes it at plend1
+    plspage(0, 0, width, height, 0, 0);
+    plscmap0n(N_COLOURS);
+    plscolbg(255, 255, 255);
+    drawing = f;
+    plsabort(record_plplot_error);
+    plinit();
+    plscol0(INK, 0, 0, 0);
+    plscol0(GRID_GREY, 225, 225, 225);
+    plscol0(WHITE, 255, 255, 255);
+    pladv(0);
+    PLFLT def, ht;
+    plgchr(&def, &ht);
+    text_base = TEXT_MM / def;
+    text_size(TEXT);
+    return 0;
+}
+
+static int is_png(const char *path)
+{
+    static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    unsigned char head[8] = {0};
+    FILE *f = fopen(path, "rb");
+    size_t got = f ? fread(head, 1, sizeof head, f) : 0;
+    if (f) fclose(f);
+    return got == sizeof head && !memcmp(head, signature, sizeof head);
+}
+
+static int end_figure(figure *f, char *err, size_t len)
+{
+    plend1();
+    plsabort(NULL);
+    drawing = NULL;
+    int rc = 0;
+    if (f->plplot_error[0]) rc = fail(err, len, "%s: PLplot: %s", f->path, f->plplot_error);
+    else if (!is_png(f->tmp)) rc = fail(err, len, "%s: PLplot wrote no PNG (disk full?)", f->path);
+    else if (rename(f->tmp, f->path) != 0)
+        rc = fail(err, len, "%s: cannot write the plot (%s)", f->path, strerror(errno));
+    if (rc) remove(f->tmp);
+    return rc;
+}
+
+static void set_colour(int slot, const double rgb[3])
+{
+    plscol0(slot, (PLINT)lround(255 * fmin(1, fmax(0, rgb[0]))), (PLINT)lround(255 * fmin(1, fmax(0, rgb[1]))),
+            (PLINT)lround(255 * fmin(1, fmax(0, rgb[2]))));
+}
+
+static int series_colour(size_t k)
+{
+    return FIRST_SERIES_COLOUR + (int)(k % (N_COLOURS - FIRST_SERIES_COLOUR));
+}
+
+// ---- layout -----------------------------------------------------------------------
+
+// The page in mm and the character height in mm (after plinit and pladv).
+typedef struct page {
+    double width, height, char_mm;
+} page;
+
+static page page_size(void)
+{
+    PLFLT x0, x1, y0, y1, def, ht;
+    plgspa(&x0, &x1, &y0, &y1);
+    plgchr(&def, &ht);
+    return (page){x1 - x0, y1 - y0, ht};
+}
+
+// Width in mm of the widest of n strings (NULL ones skipped) at a character
+// height of char_mm. PLplot 5.15 exports no string measure, so this counts
+// code points at DejaVu Sans' mean advance (about 0.6 of the height).
+static double widest_text(size_t n, const char *const *text, double char_mm)
+{
+    size_t widest = 0;
+    for (size_t k = 0; k < n; ++k) {
+        size_t points = 0;
+        for (const unsigned char *c = (const unsigned char *)text[k]; c && *c; ++c) points += (*c & 0xC0) != 0x80;
+        if (points > widest) widest = points;
+    }
+    return 0.6 * char_mm * (double)widest;
+}
+
+static void title_and_labels(const char *title, const char *xlabel, const char *ylabel)
+{
+    plcol0(INK);
+    if (xlabel) plmtex("b", 3.2, 0.5, 0.5, xlabel);
+    if (ylabel) plmtex("l", 5.0, 0.5, 0.5, ylabel);
+    if (title) {
+        text_size(TITLE);
+        plmtex("t", 1.2, 0.5, 0.5, title);
+        text_size(TEXT);
+    }
+}
+
+// Grey grid lines at the major ticks, under what is drawn next.
+static void grid_lines(int log_x, int log_y)
+{
+    plcol0(GRID_GREY);
+    plwidth(1);
+    plbox(log_x ? "gl" : "g", 0, 0, log_y ? "gl" : "g", 0, 0);
+}
+
+// A log axis spanning less than NARROW_DECADES gets labels at 1, 2 and 5 times
+// each power of ten: PLplot labels only the decades, which leaves it one label
+// or none.
+static const double NARROW_DECADES = 2.5;
+
+static void label_narrow_log_axis(int y_axis, double lo, double hi)
+{
+    char text[32];
+    for (int e = (int)floor(lo); e <= (int)ceil(hi); ++e)
+        for (int m = 1; m <= 5; m += m == 1 ? 1 : 3) {
+            double at = log10(m) + e;
+            if (at < lo - 1e-9 || at > hi + 1e-9) continue;
+            snprintf(text, sizeof text, "%g", m * pow(10, e));
+            if (y_axis) plmtex("lv", 0.7, (at - lo) / (hi - lo), 1.0, text);
+            else plmtex("b", 1.6, (at - lo) / (hi - lo), 0.5, text);
+        }
+}
+
+// The box with PLplot's ticks and labels. Fixed-point labels on a log axis
+// while its decades stay readable as plain numbers.
+static void frame(int log_x, int log_y, double x0, double x1, double y0, double y1)
+{
+    char xopt[16], yopt[16];
+    int narrow_x = log_x && x1 - x0 < NARROW_DECADES, narrow_y = log_y && y1 - y0 < NARROW_DECADES;
+    int fixed_x = log_x && x0 >= -3 && x1 <= 5, fixed_y = log_y && y0 >= -3 && y1 <= 5;
+    plcol0(INK);
+    plwidth(1);
+    snprintf(xopt, sizeof xopt, "bcst%s%s%s", narrow_x ? "" : "n", log_x ? "l" : "", fixed_x ? "f" : "");
+    snprintf(yopt, sizeof yopt, "bcstv%s%s%s", narrow_y ? "" : "n", log_y ? "l" : "", fixed_y ? "f" : "");
+    plbox(xopt, 0, 0, yopt, 0, 0);
+    if (narrow_x) label_narrow_log_axis(0, x0, x1);
+    if (narrow_y) label_narrow_log_axis(1, y0, y1);
+}
+
+// ---- markers ----------------------------------------------------------------------
+
+// Unicode glyphs, drawn by cairo's fonts: crisp at any size.
+static const char *glyph(exp_plot_marker m)
+{
+    switch (m) {
+    case EXP_MARK_SQUARE: return "■";
+    case EXP_MARK_TRIANGLE: return "▲";
+    case EXP_MARK_DIAMOND: return "◆";
+    case EXP_MARK_STAR: return "★";
+    case EXP_MARK_CROSS: return "✕";
+    case EXP_MARK_OPEN_CIRCLE: return "○";
+    case EXP_MARK_CIRCLE: break;
+    }
+    return "●";
+}
+
+static double marker_scale(exp_plot_marker m)
+{
+    return m == EXP_MARK_STAR ? 1.9 : 1.0;
+}
+
+static void mark(double x, double y, exp_plot_marker m)
+{
+    text_size(marker_scale(m));
+    plstring(1, &x, &y, glyph(m));
+    text_size(TEXT);
+}
+
+// ---- charts -----------------------------------------------------------------------
+
+// World coordinate of a value on an axis (log10 on a log axis; NAN where
+// a log axis cannot show it).
+static double world(double v, int log)
+{
+    if (!isfinite(v)) return NAN;
+    if (!log) return v;
+    return v > 0 ? log10(v) : NAN;
+}
+
+typedef struct range {
+    double lo, hi;
+} range;
+
+static void extend(range *r, double v)
+{
+    if (isfinite(v)) r->lo = fmin(r->lo, v), r->hi = fmax(r->hi, v);
+}
+
+// What the series span on one axis, in world coordinates, error bars included on y.
+static range data_span(size_t ns, const exp_plot_series *s, int y_axis, int log)
+{
+    range r = {INFINITY, -INFINITY};
     for (size_t k = 0; k < ns; ++k)
         for (size_t i = 0; i < s[k].n; ++i) {
-            double v = y ? s[k].y[i] : s[k].x[i];
-            if (!isfinite(v) || (y && log_y && v <= 0)) continue;
-            if (y && log_y) v = log10(v);
-            *lo = fmin(*lo, v), *hi = fmax(*hi, v);
+            if (s[k].style == EXP_PLOT_HLINE && (!y_axis || i > 0)) continue;
+            double v = y_axis ? s[k].y[i] : s[k].x[i];
+            extend(&r, world(v, log));
+            if (y_axis && s[k].err && isfinite(s[k].err[i])) {
+                extend(&r, world(v - s[k].err[i], log));
+                extend(&r, world(v + s[k].err[i], log));
+            }
         }
-    if (!isfinite(*lo)) *lo = 0, *hi = 1;
-    if (*hi <= *lo) *hi = *lo + (*lo != 0 ? fabs(*lo) * 0.1 : 1.0), *lo -= (*lo != 0 ? fabs(*lo) * 0.1 : 0.0);
-    if (!(y && log_y)) {
-        double pad = 0.04 * (*hi - *lo);
-        *lo -= pad, *hi += pad;
+    return r;
+}
+
+// A padded range for an axis: 5 % each side, and a single value widened to
+// ±10 % of itself (±1 at zero) so that PLplot finds several distinct ticks.
+static range padded(range r)
+{
+    if (!isfinite(r.lo)) return (range){0, 1};
+    if (r.hi - r.lo <= 1e-9 * fmax(fabs(r.lo), fabs(r.hi))) {
+        double half = r.lo != 0 ? 0.1 * fabs(r.lo) : 1;
+        return (range){r.lo - half, r.lo + half};
     }
+    double pad = 0.05 * (r.hi - r.lo);
+    return (range){r.lo - pad, r.hi + pad};
+}
+
+// An axis range: the caller's if it gave one, else the data's, padded.
+static range axis_range(double lo, double hi, range data, int log)
+{
+    if (lo < hi && (!log || lo > 0)) return (range){world(lo, log), world(hi, log)};
+    return padded(data);
+}
+
+// A log axis is worth it only where the data span a decade or more: on a
+// narrower range PLplot labels at most one tick, so such an axis is drawn linear.
+static int wants_log(int asked, size_t ns, const exp_plot_series *s, int y_axis)
+{
+    if (!asked) return 0;
+    range r = data_span(ns, s, y_axis, 1);
+    return isfinite(r.lo) && r.hi - r.lo >= 1 - 1e-9;
+}
+
+static void draw_polyline(const exp_plot_series *s, int log_x, int log_y, double shift)
+{
+    double x[256], y[256];
+    size_t m = 0;
+    for (size_t i = 0; i <= s->n; ++i) {
+        double wx = i < s->n ? world(s->x[i], log_x) + shift : NAN, wy = i < s->n ? world(s->y[i], log_y) : NAN;
+        int breaks = !isfinite(wx) || !isfinite(wy);
+        if (!breaks) x[m] = wx, y[m] = wy, m++;
+        if ((breaks || m == 256) && m > 0) {
+            if (m > 1) plline((PLINT)m, x, y);
+            // a full buffer continues from its last point
+            if (!breaks) x[0] = x[m - 1], y[0] = y[m - 1], m = 1;
+            else m = 0;
+        }
+    }
+}
+
+static void draw_error_bars(const exp_plot_series *s, int log_x, int log_y, double shift)
+{
+    plwidth(1.2);
+    for (size_t i = 0; s->err && i < s->n; ++i) {
+        double x = world(s->x[i], log_x) + shift, e = s->err[i];
+        if (!isfinite(x) || !isfinite(s->y[i]) || !isfinite(e) || e <= 0) continue;
+        double lo = world(s->y[i] - e, log_y), hi = world(s->y[i] + e, log_y);
+        if (!isfinite(lo)) lo = -1e30; // a bar below zero on a log axis runs off the bottom
+        if (isfinite(hi)) plerry(1, &x, &lo, &hi);
+    }
+}
+
+static void draw_markers_and_names(const exp_plot_series *s, int log_x, int log_y, range xr, double shift)
+{
+    for (size_t i = 0; i < s->n; ++i) {
+        double x = world(s->x[i], log_x) + shift, y = world(s->y[i], log_y);
+        if (!isfinite(x) || !isfinite(y)) continue;
+        if (s->style != EXP_PLOT_LINE) mark(x, y, s->marker);
+        if (s->names && s->names[i]) {
+            text_size(SMALL);
+            plptex(x + 0.015 * (xr.hi - xr.lo), y, 1, 0, 0, s->names[i]);
+            text_size(TEXT);
+        }
+    }
+}
+
+static void draw_series(const exp_plot_series *s, int colour, int log_x, int log_y, range xr)
+{
+    double shift = s->dodge * (xr.hi - xr.lo);
+    plcol0(colour);
+    pllsty(s->dashed ? 3 : 1);
+    plwidth(2);
+    if (s->style == EXP_PLOT_HLINE) {
+        double y = s->n ? world(s->y[0], log_y) : NAN;
+        if (isfinite(y)) pljoin(xr.lo, y, xr.hi, y);
+    } else if (s->style != EXP_PLOT_POINTS) draw_polyline(s, log_x, log_y, shift);
+    pllsty(1);
+    draw_error_bars(s, log_x, log_y, shift);
+    if (s->style != EXP_PLOT_HLINE) draw_markers_and_names(s, log_x, log_y, xr, shift);
+    plwidth(1);
+}
+
+// The legend's entries: one per labelled series, nothing for the others.
+typedef struct legend {
+    int n;
+    PLINT opt[24], colour[24], text_colour[24], style[24], symbol_count[24], box_pattern[24];
+    PLFLT width[24], symbol_scale[24], box_scale[24], box_line_width[24];
+    const char *text[24], *symbol[24];
+} legend;
+
+static void legend_add(legend *l, const char *text, int colour, int line, int dashed, const char *symbol, double scale)
+{
+    if (!text || l->n >= 24) return;
+    int k = l->n++;
+    l->opt[k] = (line ? PL_LEGEND_LINE : 0) | (symbol ? PL_LEGEND_SYMBOL : 0);
+    l->colour[k] = colour, l->text_colour[k] = INK, l->style[k] = dashed ? 3 : 1, l->width[k] = 2;
+    l->symbol[k] = symbol ? symbol : "", l->symbol_scale[k] = scale, l->symbol_count[k] = symbol ? 1 : 0;
+    l->text[k] = text;
+    l->box_pattern[k] = 0, l->box_scale[k] = 0.8, l->box_line_width[k] = 1;
+}
+
+// A band: its hatch behind its edge line.
+static void legend_add_band(legend *l, const char *text, int colour)
+{
+    int before = l->n;
+    legend_add(l, text, colour, 1, 0, NULL, 1);
+    if (l->n == before) return;
+    l->opt[before] |= PL_LEGEND_COLOR_BOX;
+    l->box_pattern[before] = 3; // PLplot's 45° lines
+}
+
+static void legend_of_series(legend *l, size_t ns, const exp_plot_series *s)
+{
+    for (size_t k = 0; k < ns; ++k) {
+        int points = s[k].style == EXP_PLOT_POINTS || s[k].style == EXP_PLOT_LINE_POINTS;
+        legend_add(l, s[k].label, series_colour(k), s[k].style != EXP_PLOT_POINTS, s[k].dashed,
+                   points ? glyph(s[k].marker) : NULL, points ? marker_scale(s[k].marker) : 1);
+    }
+}
+
+// The legend goes below the x label, in as many columns (up to 3) as the
+// page's width holds: it never covers the data.
+static int legend_columns(const legend *l, page p)
+{
+    double small_mm = p.char_mm * SMALL / TEXT, room = p.width - 10 * p.char_mm;
+    double entry_mm = widest_text((size_t)l->n, l->text, small_mm) + 0.06 * room + 4 * small_mm;
+    int columns = 3;
+    while (columns > 1 && columns * entry_mm > room) columns--;
+    return l->n < columns ? (l->n ? l->n : 1) : columns;
+}
+
+static double legend_height_mm(const legend *l, page p)
+{
+    if (l->n == 0) return 0;
+    int rows = (l->n + legend_columns(l, p) - 1) / legend_columns(l, p);
+    return (2.0 * rows + 1.0) * p.char_mm * SMALL / TEXT;
+}
+
+// Below the viewport, clear of the tick labels and the x label.
+static void legend_draw(const legend *l, page p)
+{
+    if (l->n == 0) return;
+    PLFLT x0, x1, y0, y1, w, h;
+    plgvpd(&x0, &x1, &y0, &y1);
+    int columns = legend_columns(l, p);
+    double below = 4.6 * p.char_mm / ((y1 - y0) * p.height); // in the viewport's heights
+    // pllegend takes its sizes relative to PLplot's default character, not the current one.
+    PLFLT symbol_scale[24];
+    for (int k = 0; k < l->n; ++k) symbol_scale[k] = text_base * l->symbol_scale[k];
+    pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE, 0, below,
+             0.06, WHITE, INK, 1, (l->n + columns - 1) / columns, columns, l->n, l->opt, 1.0, text_base * SMALL, 2.0,
+             0.0, l->text_colour, l->text, l->colour, l->box_pattern, l->box_scale, l->box_line_width, l->colour,
+             l->style, l->width, l->colour,
+             symbol_scale, l->symbol_count, l->symbol);
+    text_size(TEXT);
+}
+
+// The viewport in mm: room on the left for the y labels, below for the x
+// label and the legend, above for the title, and on the right for `right_mm`.
+static void viewport(page p, double right_mm, const legend *l)
+{
+    double left = 8.0 * p.char_mm, top = 3.2 * p.char_mm;
+    double bottom = 4.4 * p.char_mm + (l->n ? legend_height_mm(l, p) + 0.8 * p.char_mm : 0);
+    plsvpa(left, p.width - right_mm, bottom, p.height - top);
 }
 
 int exp_plot_png(const char *path, const exp_plot_axes *a, size_t ns, const exp_plot_series *s, int width, int height,
                  char *err, size_t len)
 {
-    double xlo = a->xlo, xhi = a->xhi, ylo = a->ylo, yhi = a->yhi;
-    if (!(xlo < xhi)) data_range(ns, s, 0, 0, &xlo, &xhi);
-    if (!(ylo < yhi)) data_range(ns, s, 1, a->log_y, &ylo, &yhi);
-    else if (a->log_y) ylo = log10(ylo), yhi = log10(yhi);
-    if (a->log_y) ylo = floor(ylo), yhi = ceil(yhi) > floor(ylo) ? ceil(yhi) : floor(ylo) + 1;
-    cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
-    cairo_t *cr = cairo_create(surf);
-    const double L = 90, R = 20, T = 40, B = 60, pw = width - L - R, ph = height - T - B;
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr, 13);
-#define PX(v) (L + ((v) - xlo) / (xhi - xlo) * pw)
-#define PY(v) (T + ph - ((v) - ylo) / (yhi - ylo) * ph)
-    cairo_text_extents_t te;
-    char buf[64];
-    cairo_set_line_width(cr, 1);
-    // Ticks and grid.
-    double xs = tick_step(xhi - xlo), ys = a->log_y ? 1.0 : tick_step(yhi - ylo);
-    for (double v = ceil(xlo / xs) * xs; v <= xhi + 1e-9 * xs; v += xs) {
-        cairo_set_source_rgb(cr, 0.9, 0.9, 0.9);
-        cairo_move_to(cr, PX(v), T), cairo_line_to(cr, PX(v), T + ph), cairo_stroke(cr);
-        snprintf(buf, sizeof buf, "%g", fabs(v) < 1e-12 * xs ? 0.0 : v);
-        cairo_text_extents(cr, buf, &te);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, PX(v) - te.width / 2, T + ph + 18), cairo_show_text(cr, buf);
-    }
-    for (double v = ceil(ylo / ys) * ys; v <= yhi + 1e-9 * ys; v += ys) {
-        cairo_set_source_rgb(cr, 0.9, 0.9, 0.9);
-        cairo_move_to(cr, L, PY(v)), cairo_line_to(cr, L + pw, PY(v)), cairo_stroke(cr);
-        if (a->log_y) snprintf(buf, sizeof buf, "1e%g", v);
-        else snprintf(buf, sizeof buf, "%g", fabs(v) < 1e-12 * ys ? 0.0 : v);
-        cairo_text_extents(cr, buf, &te);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, L - te.width - 6, PY(v) + 4), cairo_show_text(cr, buf);
-    }
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    cairo_rectangle(cr, L, T, pw, ph), cairo_stroke(cr);
-    // Labels and title.
-    if (a->xlabel) {
-        cairo_text_extents(cr, a->xlabel, &te);
-        cairo_move_to(cr, L + pw / 2 - te.width / 2, height - 18), cairo_show_text(cr, a->xlabel);
-    }
-    if (a->ylabel) {
-        cairo_save(cr);
-        cairo_text_extents(cr, a->ylabel, &te);
-        cairo_move_to(cr, 20, T + ph / 2 + te.width / 2), cairo_rotate(cr, -DEM_PI / 2), cairo_show_text(cr, a->ylabel);
-        cairo_restore(cr);
-    }
-    if (a->title) {
-        cairo_set_font_size(cr, 15);
-        cairo_text_extents(cr, a->title, &te);
-        cairo_move_to(cr, L + pw / 2 - te.width / 2, 24), cairo_show_text(cr, a->title);
-        cairo_set_font_size(cr, 13);
-    }
-    // Curves, clipped to the plot area.
-    cairo_save(cr);
-    cairo_rectangle(cr, L, T, pw, ph), cairo_clip(cr);
-    cairo_set_line_width(cr, 1.6);
+    figure f;
+    if (begin_figure(&f, path, width, height, err, len)) return 1;
+    int log_x = wants_log(a->log_x, ns, s, 0), log_y = wants_log(a->log_y, ns, s, 1);
+    range xr = axis_range(a->xlo, a->xhi, data_span(ns, s, 0, log_x), log_x);
+    range yr = axis_range(a->ylo, a->yhi, data_span(ns, s, 1, log_y), log_y);
+    legend l = {0};
+    legend_of_series(&l, ns, s);
+    page p = page_size();
+    viewport(p, 2.5 * p.char_mm, &l);
+    plwind(xr.lo, xr.hi, yr.lo, yr.hi);
+    grid_lines(log_x, log_y);
     for (size_t k = 0; k < ns; ++k) {
-        double dash = 6;
-        cairo_set_dash(cr, &dash, s[k].dashed ? 1 : 0, 0);
-        cairo_set_source_rgb(cr, s[k].rgb[0], s[k].rgb[1], s[k].rgb[2]);
-        int pen = 0;
-        for (size_t i = 0; i < s[k].n; ++i) {
-            double y = s[k].y[i];
-            if (a->log_y) y = y > 0 ? log10(y) : NAN;
-            if (!isfinite(y) || !isfinite(s[k].x[i])) {
-                if (pen) cairo_stroke(cr);
-                pen = 0;
-                continue;
-            }
-            if (pen) cairo_line_to(cr, PX(s[k].x[i]), PY(y));
-            else cairo_move_to(cr, PX(s[k].x[i]), PY(y)), pen = 1;
-        }
-        if (pen) cairo_stroke(cr);
+        set_colour(series_colour(k), s[k].rgb);
+        draw_series(&s[k], series_colour(k), log_x, log_y, xr);
     }
-    cairo_restore(cr);
-    // Legend, top left inside the plot.
-    double ly = T + 18;
-    for (size_t k = 0; k < ns; ++k) {
-        if (!s[k].label) continue;
-        double dash = 6;
-        cairo_set_dash(cr, &dash, s[k].dashed ? 1 : 0, 0);
-        cairo_set_source_rgb(cr, s[k].rgb[0], s[k].rgb[1], s[k].rgb[2]);
-        cairo_set_line_width(cr, 2);
-        cairo_move_to(cr, L + 10, ly - 4), cairo_line_to(cr, L + 34, ly - 4), cairo_stroke(cr);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, L + 40, ly), cairo_show_text(cr, s[k].label);
-        ly += 17;
+    frame(log_x, log_y, xr.lo, xr.hi, yr.lo, yr.hi); // over what was drawn at its edges
+    title_and_labels(a->title, a->xlabel, a->ylabel);
+    legend_draw(&l, p);
+    return end_figure(&f, err, len);
+}
+
+// ---- maps -------------------------------------------------------------------------
+
+enum { MAP_NODES = 321, MAP_LEVELS = 16 };
+
+// The interpolated map: z at MAP_NODES × MAP_NODES nodes over the rectangle in
+// world coordinates (NAN outside the points' convex hull).
+typedef struct map_grid {
+    double x0, x1, y0, y1;
+    double *z[MAP_NODES];
+    double storage[MAP_NODES * MAP_NODES];
+    double zlo, zhi;
+    int filled; ///< 0 where the points do not span an area
+} map_grid;
+
+// The points, in the unit square, with failed and repeated ones dropped
+// (the triangulation needs distinct points; a repeat's z is averaged in).
+static size_t unit_points(const exp_plot_map *m, const map_grid *g, double *u, double *v, double *z)
+{
+    size_t n = 0;
+    int *count = calloc(m->n ? m->n : 1, sizeof *count);
+    for (size_t i = 0; count && i < m->n; ++i) {
+        double wy = world(m->y[i], m->log_y);
+        if (!isfinite(m->z[i]) || !isfinite(m->x[i]) || !isfinite(wy)) continue;
+        double pu = (m->x[i] - g->x0) / (g->x1 - g->x0), pv = (wy - g->y0) / (g->y1 - g->y0);
+        size_t k = 0;
+        while (k < n && (fabs(u[k] - pu) > 1e-9 || fabs(v[k] - pv) > 1e-9)) ++k;
+        if (k == n) u[n] = pu, v[n] = pv, z[n] = 0, count[n] = 0, n++;
+        z[k] = (z[k] * count[k] + m->z[i]) / (count[k] + 1), count[k]++;
     }
-#undef PX
-#undef PY
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    cairo_status_t st = cairo_surface_write_to_png(surf, tmp);
-    cairo_destroy(cr);
-    cairo_surface_destroy(surf);
-    if (st != CAIRO_STATUS_SUCCESS || rename(tmp, path) != 0) {
-        snprintf(err, len, "cannot write '%s': %s", path, cairo_status_to_string(st));
-        remove(tmp);
-        return 1;
-    }
+    free(count);
+    return n;
+}
+
+// Whether the points span an area (the triangulation fails on a line).
+static int spans_area(size_t n, const double *u, const double *v)
+{
+    for (size_t j = 1; j < n; ++j)
+        for (size_t k = j + 1; k < n; ++k)
+            if (fabs((u[j] - u[0]) * (v[k] - v[0]) - (u[k] - u[0]) * (v[j] - v[0])) > 1e-6) return 1;
     return 0;
+}
+
+static void grid_range(map_grid *g)
+{
+    g->zlo = INFINITY, g->zhi = -INFINITY;
+    for (int k = 0; k < MAP_NODES * MAP_NODES; ++k)
+        if (isfinite(g->storage[k])) g->zlo = fmin(g->zlo, g->storage[k]), g->zhi = fmax(g->zhi, g->storage[k]);
+    g->filled = isfinite(g->zlo);
+    if (g->filled && g->zhi - g->zlo < 1e-9) g->zlo -= 0.5, g->zhi += 0.5;
+}
+
+static void interpolate(const exp_plot_map *m, map_grid *g)
+{
+    for (int i = 0; i < MAP_NODES; ++i) g->z[i] = g->storage + (size_t)i * MAP_NODES;
+    for (int k = 0; k < MAP_NODES * MAP_NODES; ++k) g->storage[k] = NAN;
+    size_t cap = m->n ? m->n : 1;
+    double *u = malloc(cap * sizeof *u), *v = malloc(cap * sizeof *v), *z = malloc(cap * sizeof *z);
+    size_t n = u && v && z ? unit_points(m, g, u, v, z) : 0;
+    if (n >= 3 && spans_area(n, u, v)) {
+        double nodes[MAP_NODES];
+        for (int i = 0; i < MAP_NODES; ++i) nodes[i] = (double)i / (MAP_NODES - 1);
+        plgriddata(u, v, z, (PLINT)n, nodes, MAP_NODES, nodes, MAP_NODES, g->z, GRID_DTLI, 0);
+    }
+    free(u), free(v), free(z);
+    grid_range(g);
+}
+
+// plshades' `defined` callback gets world coordinates and no user data:
+// the grid being drawn is held here for the length of one figure.
+static const map_grid *shading;
+
+// Inside the hull: the grid node nearest (x, y) was interpolated.
+static PLINT inside_hull(PLFLT x, PLFLT y)
+{
+    const map_grid *g = shading;
+    long i = lround((x - g->x0) / (g->x1 - g->x0) * (MAP_NODES - 1));
+    long j = lround((y - g->y0) / (g->y1 - g->y0) * (MAP_NODES - 1));
+    if (i < 0 || j < 0 || i >= MAP_NODES || j >= MAP_NODES) return 0;
+    return isfinite(g->z[i][j]);
+}
+
+// Stricter, for the band's hatch: the grid cell holding (x, y) has four
+// interpolated corners. A cell across the hull's edge is out: its part between
+// the value outside and the one inside would hatch a dotted line along the edge.
+static PLINT cell_inside_hull(PLFLT x, PLFLT y)
+{
+    const map_grid *g = shading;
+    double u = (x - g->x0) / (g->x1 - g->x0) * (MAP_NODES - 1), v = (y - g->y0) / (g->y1 - g->y0) * (MAP_NODES - 1);
+    long i = (long)floor(u), j = (long)floor(v);
+    if (i == MAP_NODES - 1) i--; // the rectangle's far edges belong to the last cells
+    if (j == MAP_NODES - 1) j--;
+    if (i < 0 || j < 0 || i >= MAP_NODES - 1 || j >= MAP_NODES - 1) return 0;
+    return isfinite(g->z[i][j]) && isfinite(g->z[i + 1][j]) && isfinite(g->z[i][j + 1]) && isfinite(g->z[i + 1][j + 1]);
+}
+
+// A pale-to-deep sequential colour map (cmap1): readable under black markers
+// at both ends.
+static void sequential_colours(void)
+{
+    PLFLT at[] = {0, 0.35, 0.7, 1}, r[] = {0.99, 0.60, 0.25, 0.20}, gr[] = {0.95, 0.85, 0.60, 0.30},
+          b[] = {0.75, 0.60, 0.75, 0.65};
+    plscmap1n(256);
+    plscmap1l(1, 4, at, r, gr, b, NULL);
+}
+
+// The grid's rows for plshade(s), which read every node: the nodes outside the
+// hull get a value below every level and band (`floor`), so that no shade
+// spans them, and inside_hull trims the cells along the hull's edge. (Given a
+// value inside a shade, plshade merges them with the hull into rectangles that
+// the `defined` callback cannot cut back to the hull.)
+static void finite_rows(const map_grid *g, double floor, const double **rows)
+{
+    static double copy_storage[MAP_NODES * MAP_NODES];
+    for (int k = 0; k < MAP_NODES * MAP_NODES; ++k) copy_storage[k] = isfinite(g->storage[k]) ? g->storage[k] : floor;
+    for (int i = 0; i < MAP_NODES; ++i) rows[i] = copy_storage + (size_t)i * MAP_NODES;
+}
+
+static void shade(const map_grid *g, double *levels)
+{
+    const double *rows[MAP_NODES];
+    finite_rows(g, g->zlo - (g->zhi - g->zlo) - 1, rows);
+    for (int k = 0; k < MAP_LEVELS; ++k) levels[k] = g->zlo + (g->zhi - g->zlo) * k / (MAP_LEVELS - 1);
+    shading = g;
+    plshades(rows, MAP_NODES, MAP_NODES, inside_hull, g->x0, g->x1, g->y0, g->y1, levels, MAP_LEVELS, 1, 0, 0, plfill,
+             1, NULL, NULL);
+    shading = NULL;
+}
+
+// The band between two levels hatched, so that it reads as a band even where
+// only one of its edges crosses the map.
+static const PLINT HATCH_ANGLE[1] = {450}, HATCH_SPACING[1] = {2500}; // tenths of a degree, micrometres
+
+static void hatch_band(const map_grid *g, double lo, double hi, int colour)
+{
+    const double *rows[MAP_NODES];
+    lo = isfinite(lo) ? lo : g->zlo - 1, hi = isfinite(hi) ? hi : g->zhi + 1;
+    finite_rows(g, fmin(lo, g->zlo) - (g->zhi - g->zlo) - 1, rows);
+    shading = g;
+    plpat(1, HATCH_ANGLE, HATCH_SPACING);
+    plwidth(1);
+    plshade(rows, MAP_NODES, MAP_NODES, cell_inside_hull, g->x0, g->x1, g->y0, g->y1, lo, hi, 0, colour, 1, 0, 0, 0, 0, plfill,
+            1, NULL, NULL);
+    plpsty(0);
+    shading = NULL;
+}
+
+// One contour level by marching squares over the grid's cells whose four
+// corners are all inside the hull: no line is drawn where the map is white.
+static void contour(const map_grid *g, double level)
+{
+    double dx = (g->x1 - g->x0) / (MAP_NODES - 1), dy = (g->y1 - g->y0) / (MAP_NODES - 1);
+    static const int corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int i = 0; i + 1 < MAP_NODES; ++i)
+        for (int j = 0; j + 1 < MAP_NODES; ++j) {
+            double px[4], py[4];
+            int crossings = 0, whole = 1;
+            for (int e = 0; e < 4 && whole; ++e) {
+                const int *p = corner[e], *q = corner[(e + 1) % 4];
+                double a = g->z[i + p[0]][j + p[1]] - level, b = g->z[i + q[0]][j + q[1]] - level;
+                whole = isfinite(a) && isfinite(b);
+                if (!whole || (a > 0) == (b > 0)) continue;
+                double t = a / (a - b);
+                px[crossings] = g->x0 + dx * (i + p[0] + t * (q[0] - p[0]));
+                py[crossings] = g->y0 + dy * (j + p[1] + t * (q[1] - p[1]));
+                crossings++;
+            }
+            for (int c = 0; whole && c + 1 < crossings; c += 2) pljoin(px[c], py[c], px[c + 1], py[c + 1]);
+        }
+}
+
+// The colour scale on the right, PLplot choosing its ticks.
+static void colour_bar(const exp_plot_map *m, const double *levels)
+{
+    PLFLT w, h;
+    const char *axis_opts[] = {"bcvtm"};
+    PLFLT ticks[] = {0};
+    PLINT sub_ticks[] = {0}, n_values[] = {MAP_LEVELS}, label_opts[] = {PL_COLORBAR_LABEL_RIGHT};
+    const PLFLT *values[] = {levels};
+    const char *labels[] = {m->zlabel ? m->zlabel : ""};
+    plcol0(INK);
+    text_size(SMALL);
+    plcolorbar(&w, &h, PL_COLORBAR_SHADE, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0, 0.035, 1.0, 0, INK, 0, 0, 0,
+               0, 0, 1, label_opts, labels, 1, axis_opts, ticks, sub_ticks, n_values, values);
+    text_size(TEXT);
+}
+
+// Every evaluated point as a white disc ringed in black (visible on any
+// colour), a failed one as a cross, the chosen one as a large star.
+static void map_markers(const exp_plot_map *m, int chosen_colour)
+{
+    for (size_t i = 0; i < m->n; ++i) {
+        double x = m->x[i], y = world(m->y[i], m->log_y);
+        if (!isfinite(x) || !isfinite(y)) continue;
+        plcol0(INK);
+        if (!isfinite(m->z[i])) {
+            mark(x, y, EXP_MARK_CROSS);
+            continue;
+        }
+        plcol0(WHITE), mark(x, y, EXP_MARK_CIRCLE);
+        plcol0(INK), mark(x, y, EXP_MARK_OPEN_CIRCLE);
+    }
+    if (m->chosen >= 0 && (size_t)m->chosen < m->n) {
+        double x = m->x[m->chosen], y = world(m->y[m->chosen], m->log_y);
+        plcol0(chosen_colour);
+        if (isfinite(x) && isfinite(y)) mark(x, y, EXP_MARK_STAR);
+    }
+}
+
+// Without a fill (points that span no area) each point's value is written beside it.
+static void map_values(const exp_plot_map *m, const map_grid *g)
+{
+    char text[32];
+    plcol0(INK);
+    text_size(SMALL);
+    for (size_t i = 0; i < m->n; ++i) {
+        double x = m->x[i], y = world(m->y[i], m->log_y);
+        if (!isfinite(x) || !isfinite(y) || !isfinite(m->z[i])) continue;
+        snprintf(text, sizeof text, "%.3g", m->z[i]);
+        plptex(x + 0.02 * (g->x1 - g->x0), y, 1, 0, 0, text);
+    }
+    text_size(TEXT);
+}
+
+static int any_failed(const exp_plot_map *m)
+{
+    for (size_t i = 0; i < m->n; ++i)
+        if (!isfinite(m->z[i])) return 1;
+    return 0;
+}
+
+static legend map_legend(const exp_plot_map *m, int filled, int band_colour, int chosen_colour)
+{
+    legend l = {0};
+    legend_add(&l, m->points_label ? m->points_label : "evaluated", INK, 0, 0, glyph(EXP_MARK_OPEN_CIRCLE), 1);
+    if (any_failed(m)) legend_add(&l, "failed run", INK, 0, 0, glyph(EXP_MARK_CROSS), 1);
+    if (m->chosen >= 0)
+        legend_add(&l, m->chosen_label ? m->chosen_label : "chosen", chosen_colour, 0, 0, glyph(EXP_MARK_STAR), 1.4);
+    if (filled && (isfinite(m->band_lo) || isfinite(m->band_hi)))
+        legend_add_band(&l, m->band_label, band_colour);
+    return l;
+}
+
+int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int height, char *err, size_t len)
+{
+    map_grid *g = calloc(1, sizeof *g);
+    if (!g) return fail(err, len, "%s: out of memory for the map", path);
+    g->x0 = m->xlo, g->x1 = m->xhi, g->y0 = world(m->ylo, m->log_y), g->y1 = world(m->yhi, m->log_y);
+    if (!(g->x0 < g->x1) || !(g->y0 < g->y1)) {
+        free(g);
+        return fail(err, len, "%s: the map's rectangle is empty", path);
+    }
+    figure f;
+    if (begin_figure(&f, path, width, height, err, len)) return free(g), 1;
+    interpolate(m, g);
+    enum { BAND = FIRST_SERIES_COLOUR, CHOSEN };
+    plscol0(BAND, 0, 0, 0), plscol0(CHOSEN, 215, 25, 28);
+    legend l = map_legend(m, g->filled, BAND, CHOSEN);
+    page p = page_size();
+    viewport(p, (g->filled ? 10 : 2.5) * p.char_mm, &l);
+    plwind(g->x0, g->x1, g->y0, g->y1);
+    double levels[MAP_LEVELS];
+    if (g->filled) {
+        sequential_colours();
+        shade(g, levels);
+        if (isfinite(m->band_lo) || isfinite(m->band_hi)) hatch_band(g, m->band_lo, m->band_hi, BAND);
+        plcol0(BAND), plwidth(2.5);
+        if (isfinite(m->band_lo)) contour(g, m->band_lo);
+        if (isfinite(m->band_hi)) contour(g, m->band_hi);
+        plwidth(1);
+    }
+    frame(0, m->log_y, g->x0, g->x1, g->y0, g->y1);
+    map_markers(m, CHOSEN);
+    if (!g->filled) map_values(m, g);
+    if (g->filled) colour_bar(m, levels);
+    title_and_labels(m->title, m->xlabel, m->ylabel);
+    legend_draw(&l, p);
+    free(g);
+    return end_figure(&f, err, len);
 }

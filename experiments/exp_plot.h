@@ -1,33 +1,90 @@
 // SPDX-License-Identifier: MIT
 /// @file exp_plot.h
-/// Line plots of measured curves (force–displacement, contacts and kinetic
-/// energy over time) as PNG, drawn with cairo: axes with ticks, one colour
-/// per series, a legend. Enough for a result to be looked at, no more.
+/// Every figure granucal draws, as PNG, drawn by PLplot through its pngcairo
+/// device: charts of series on one pair of axes (lines, markers, error bars,
+/// a name beside each point, a labelled horizontal reference line, log axes)
+/// and filled maps of a quantity measured at scattered points of a plane.
+/// PLplot chooses the ticks; every labelled series gets a legend entry and an
+/// unlabelled one none.
+///
+/// PLplot's state is process-global: each call begins and ends its figure, so
+/// figures never interleave. Call from one thread only (never inside an
+/// OpenMP region).
 #ifndef EXP_PLOT_H
 #define EXP_PLOT_H
 
 #include <stddef.h>
 
-/// One curve: n points (x[k], y[k]); a NaN y breaks the line.
+/// How a series is drawn. The zero value is a line, so a series written as a
+/// positional initialiser without the trailing fields stays a line.
+typedef enum exp_plot_style {
+    EXP_PLOT_LINE = 0,
+    EXP_PLOT_POINTS,
+    EXP_PLOT_LINE_POINTS,
+    EXP_PLOT_HLINE, ///< a horizontal line across the whole x range at y[0] (n ≥ 1)
+} exp_plot_style;
+
+typedef enum exp_plot_marker {
+    EXP_MARK_CIRCLE = 0,
+    EXP_MARK_SQUARE,
+    EXP_MARK_TRIANGLE,
+    EXP_MARK_DIAMOND,
+    EXP_MARK_STAR, ///< reserved by convention for what was chosen
+    EXP_MARK_CROSS,
+    EXP_MARK_OPEN_CIRCLE,
+} exp_plot_marker;
+
+/// One series: n points (x[k], y[k]); a non-finite value breaks the line and
+/// is not marked.
 typedef struct exp_plot_series {
     size_t n;
     const double *x, *y;
-    const char *label; ///< legend text, or NULL
+    const char *label; ///< legend text; NULL: drawn, but not in the legend
     double rgb[3];     ///< colour, components in [0, 1]
     int dashed;
+    const double *err;         ///< y error bars y ± err[k], or NULL
+    exp_plot_style style;
+    exp_plot_marker marker;    ///< for POINTS and LINE_POINTS
+    const char *const *names;  ///< text beside each point (NULL, or NULL entries: none)
+    double dodge;              ///< drawn shifted sideways by this fraction of the x axis, so that
+                               ///< series measured at the same x stay apart (0: none)
 } exp_plot_series;
 
-/// Axes of a plot; a range with lo >= hi is taken from the data.
+/// Axes of a chart; a range with lo >= hi is taken from the data (and the
+/// error bars), padded; a range of one value is widened to ±10 % of it.
 typedef struct exp_plot_axes {
     const char *title, *xlabel, *ylabel;
     double xlo, xhi, ylo, yhi;
     int log_y; ///< logarithmic y axis (non-positive values are skipped)
+    int log_x; ///< logarithmic x axis (non-positive values are skipped)
 } exp_plot_axes;
 
 /// Write a PNG of `width` × `height` pixels with the series on one pair of
 /// axes. 0 on success, else non-zero with a message naming the file.
 int exp_plot_png(const char *path, const exp_plot_axes *axes, size_t n_series, const exp_plot_series *series,
                  int width, int height, char *err, size_t len);
+
+/// A quantity z measured at n scattered points (x, y) of a rectangle, drawn
+/// as a filled map: z interpolated linearly over the Delaunay triangulation of
+/// the points (PLplot's plgriddata), left white outside their convex hull;
+/// each point marked; two contour lines (a band, e.g. a target ± its
+/// tolerance) drawn only where the map is filled; one point starred.
+typedef struct exp_plot_map {
+    const char *title, *xlabel, *ylabel, *zlabel; ///< zlabel: the colour bar's
+    size_t n;
+    const double *x, *y, *z; ///< a non-finite z: a failed evaluation, marked by a cross
+    double xlo, xhi, ylo, yhi; ///< the rectangle (the search's bounds)
+    int log_y;                 ///< y on a log axis; the interpolation is in log y too
+    double band_lo, band_hi;   ///< contour levels; non-finite: none
+    const char *band_label;    ///< legend text of the band's lines
+    const char *points_label;  ///< legend text of the markers
+    long chosen;               ///< index of the starred point, or -1
+    const char *chosen_label;  ///< legend text of the star
+} exp_plot_map;
+
+/// Write a map as a PNG of `width` × `height` pixels. 0 on success, else
+/// non-zero with a message naming the file.
+int exp_plot_map_png(const char *path, const exp_plot_map *map, int width, int height, char *err, size_t len);
 
 /// A colour of a small qualitative palette (k wraps around).
 void exp_plot_colour(int k, double rgb[3]);

@@ -335,12 +335,13 @@ int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const 
         t[k] = r->series[k].t, c[k] = (double)r->series[k].contacts,
         ke[k] = r->series[k].ke_translational + r->series[k].ke_rotational;
     char path[1200];
-    exp_plot_series s = {n, t, c, "granucal", {0.12, 0.47, 0.71}, 0};
-    exp_plot_axes ax = {"Silo discharge: contacts (Fig. A.4)", "t (s)", "contacts", 0, 0, 0, 0, 0};
+    exp_plot_series s = {.n = n, .x = t, .y = c, .label = "granucal", .rgb = {0.12, 0.47, 0.71}};
+    exp_plot_axes ax = {.title = "Silo discharge: contacts (Fig. A.4)", .xlabel = "t (s)", .ylabel = "contacts"};
     snprintf(path, sizeof path, "%scontacts.png", png_prefix);
     int rc = exp_plot_png(path, &ax, 1, &s, 900, 500, err, len);
     s.y = ke;
-    exp_plot_axes ax2 = {"Silo discharge: kinetic energy (Fig. A.5)", "t (s)", "kinetic energy (J)", 0, 0, 0, 0, 1};
+    exp_plot_axes ax2 = {.title = "Silo discharge: kinetic energy (Fig. A.5)", .xlabel = "t (s)", .ylabel = "kinetic energy (J)",
+                         .log_y = 1};
     snprintf(path, sizeof path, "%skinetic_energy.png", png_prefix);
     if (!rc) rc = exp_plot_png(path, &ax2, 1, &s, 900, 500, err, len);
     free(t), free(c), free(ke);

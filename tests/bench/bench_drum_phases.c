@@ -88,12 +88,14 @@ int main(int argc, char **argv)
         printf(" rpm=%g status=%s steady=%d turn_sim_s=%.2f turn_wall_s=%.2f measure_wall_s=%.2f measure_share=%.3f "
                "turn_dt_s=%.4g turn_particle_steps_per_s=%.4g turn_stepping_particle_steps_per_s=%.4g "
                "end_to_end_particle_steps_per_s=%.4g end_to_end_over_kernel=%.3f "
-               "angle_deg=%.3f angle_sd_deg=%.3f csa_percent=%.3f csa_sd_percent=%.3f",
+               "angle_deg=%.3f angle_sd_deg=%.3f csa_percent=%.3f csa_sd_percent=%.3f "
+               "network_check_wall_s=%.2f network_check_share=%.4f dt_margin_min=%.3f dt_lowered=%d",
                o.rpm, st == DEM_OK ? "ok" : dem_world_error(w), r.steady, r.simulated_time_s, turn_wall,
                r.measure_wall_s, r.measure_wall_s / turn_wall, dem_world_dt(w), steps / turn_wall,
                steps / (turn_wall - r.measure_wall_s), (steps + fill_steps) / (turn_wall + fill_wall),
                (steps + fill_steps) / (turn_wall + fill_wall) / kernel, r.angle_deg, r.angle_sd_deg,
-               r.csa_percent, r.csa_sd_percent);
+               r.csa_percent, r.csa_sd_percent, r.network_check_wall_s, r.network_check_wall_s / turn_wall,
+               r.dt_margin_min, r.dt_lowered);
     }
     printf("\n");
     dem_world_destroy(w);

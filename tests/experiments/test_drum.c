@@ -3,7 +3,8 @@
 // resting bed first turns with the drum as a rigid body, so its surface angle
 // grows at the drum's angular velocity (4 rpm = 24°/s) — an independent,
 // kinematic check of the rotating wall, the measurement and the units. The
-// start tilt turns the bed the same way, by its angle.
+// start tilt turns the bed the same way, by its angle. Checking the turn's
+// step against the bed's network leaves the run as it is.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -79,8 +80,47 @@ static void test_fill_and_rigid_turn(void **state)
     exp_drum_config_free(y);
 }
 
+// The turn's checks of its step against the bed's network (issue 21) read
+// the bed only: a run checked at every sample is the run never checked, bit
+// for bit, as long as no check lowers the step; and they report the margin.
+static void test_network_checks_leave_the_run(void **state)
+{
+    (void)state;
+    char path[1024], err[512];
+    const char *src = getenv("GRANUCAL_SOURCE_DIR");
+    snprintf(path, sizeof path, "%s/configs/drum.yaml", src ? src : ".");
+    char *sets[] = {"lambda=65536", "slice_depth=0.04"};
+    exp_drum_yaml *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
+    if (!y) fail_msg("%s", err);
+    exp_drum_def d;
+    exp_drum_run_opts run;
+    assert_int_equal(exp_drum_config_defs(y, &d, &run, err, sizeof err), 0);
+    dem_world *bed = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
+    if (!bed) fail_msg("%s", err);
+    run.rpm = 40, run.max_time = 1.0, run.window = 0.25;
+    exp_drum_result r[2];
+    for (int checked = 0; checked < 2; ++checked) {
+        dem_world *w = dem_world_clone(bed);
+        assert_non_null(w);
+        run.network_check_interval = checked ? run.sample_interval : 0;
+        assert_int_equal(exp_drum_rotate(w, &d, &run, NULL, NULL, &r[checked]), DEM_OK);
+        dem_world_destroy(w);
+    }
+    printf("checked every sample: margin at least %.3f, lowered %d times, %.3f s of checks; angle %.17g / %.17g\n",
+           r[1].dt_margin_min, r[1].dt_lowered, r[1].network_check_wall_s, r[1].angle_deg, r[0].angle_deg);
+    assert_true(isnan(r[0].dt_margin_min));
+    assert_true(r[1].dt_margin_min > 1);
+    assert_int_equal(r[1].dt_lowered, 0);
+    assert_memory_equal(&r[1].angle_deg, &r[0].angle_deg, sizeof r[0].angle_deg);
+    assert_memory_equal(&r[1].csa_percent, &r[0].csa_percent, sizeof r[0].csa_percent);
+    assert_int_equal(r[1].particle_steps, r[0].particle_steps);
+    dem_world_destroy(bed);
+    exp_drum_config_free(y);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_fill_and_rigid_turn)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_fill_and_rigid_turn),
+                                       cmocka_unit_test(test_network_checks_leave_the_run)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
