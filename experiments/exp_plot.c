@@ -384,8 +384,10 @@ static void draw_markers_and_names(const exp_plot_series *s, int log_x, int log_
         if (!isfinite(x) || !isfinite(y)) continue;
         if (s->style != EXP_PLOT_LINE) mark(x, y, s->marker);
         if (s->names && s->names[i]) {
+            // beside the point, on the side with room for it (text past the axes is clipped)
+            int left = x - xr.lo > 0.7 * (xr.hi - xr.lo);
             text_size(SMALL);
-            plptex(x + 0.015 * (xr.hi - xr.lo), y, 1, 0, 0, s->names[i]);
+            plptex(x + (left ? -0.015 : 0.015) * (xr.hi - xr.lo), y, 1, 0, left ? 1.0 : 0.0, s->names[i]);
             text_size(TEXT);
         }
     }
