@@ -40,7 +40,7 @@ awk 'BEGIN {print "t_s,contacts,ke_translational_J,ke_rotational_J,discharged"}
 
 # 3. Compare.
 cc -O2 -std=c11 -I"$root/experiments" -I"$root/engine" "$root/tests/peers/silo/compare_silo.c" \
-   "$root/experiments/exp_plot.c" $(pkg-config --cflags --libs cairo) -lm -o "$work/compare_silo"
+   "$root/experiments/exp_plot.c" $(pkg-config --cflags --libs plplot) -lm -o "$work/compare_silo"
 cp "$work/granucal/series.csv" "$out/granucal_series.csv"
 cp "$work/liggghts.csv" "$out/liggghts_series.csv"
 cp "$work/granucal.json" "$out/granucal_result.json"
