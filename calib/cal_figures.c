@@ -31,25 +31,29 @@ static exp_plot_series level(const double *y, const char *label, const double rg
 
 int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, char *err, size_t len)
 {
-    char path[1200], chosen_label[96];
+    char path[1200], chosen_label[128];
     snprintf(path, sizeof path, "%s/cn_vs_k.png", dir);
     double chosen_k[1] = {s->chosen_k}, chosen_cn[1] = {NAN};
     for (int i = 0; i < s->n; ++i)
         if (s->k[i] == s->chosen_k) chosen_cn[0] = s->cn_mean[i];
-    snprintf(chosen_label, sizeof chosen_label, "chosen k_n = %.4g N/m", s->chosen_k);
-    double limit[1] = {s->stiff_limit}, floor_[1] = {s->stiff_limit - s->tolerance};
-    exp_plot_series series[4];
+    // An unresolved sweep chooses nothing: the calibration goes on with the config's k_n.
+    if (s->resolved) snprintf(chosen_label, sizeof chosen_label, "chosen k_n = %.4g N/m", s->chosen_k);
+    else snprintf(chosen_label, sizeof chosen_label, "k_n = %.4g N/m: within the noise already (not resolved)", s->chosen_k);
+    double limit[1] = {s->stiff_limit}, lower[1] = {s->stiff_limit - s->tolerance},
+           upper[1] = {s->stiff_limit + s->tolerance};
+    exp_plot_series series[5];
     series[0] = (exp_plot_series){.n = (size_t)s->n, .x = s->k, .y = s->cn_mean, .err = s->cn_sd,
                                   .label = "mean over seeds (bars: seed-to-seed sd)",
                                   .rgb = {blue[0], blue[1], blue[2]},
                                   .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_CIRCLE};
     series[1] = level(limit, "stiff limit (CN of the stiffest k_n)", grey, 0);
-    series[2] = level(floor_, "stiff limit − tolerance", grey, 1);
-    series[3] = points(1, chosen_k, chosen_cn, chosen_label, red, EXP_MARK_STAR);
+    series[2] = level(lower, "stiff limit ± tolerance", grey, 1);
+    series[3] = level(upper, NULL, grey, 1);
+    series[4] = points(1, chosen_k, chosen_cn, chosen_label, red, s->resolved ? EXP_MARK_STAR : EXP_MARK_OPEN_CIRCLE);
     exp_plot_axes axes = {.title = "Stage 1: coordination number of the poured cylinder (Fig. 12)",
                           .xlabel = "granule stiffness k_n (N/m, real powder)",
                           .ylabel = "coordination number (granule–granule)", .log_x = 1};
-    return exp_plot_png(path, &axes, 4, series, WIDTH, HEIGHT, err, len);
+    return exp_plot_png(path, &axes, 5, series, WIDTH, HEIGHT, err, len);
 }
 
 // ---- friction stages ---------------------------------------------------------------
