@@ -1,26 +1,70 @@
 // SPDX-License-Identifier: MIT
-// `granucal measure PHOTO.png`: the angle of repose and occupied CSA of a
-// real drum photograph, by the same raster code that measures simulations.
+// `granucal measure PHOTO.png...`: the angle of repose and occupied CSA of
+// real drum photographs (or the frames of a video), and their mean and
+// spread as the rows of experiments/data/'s CSV files.
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
 
 #include "cal_commands.h"
-#include "exp_image.h"
+#include "cal_data.h"
+#include "exp_photo.h"
 
 static const char measure_help[] =
-    "usage: granucal measure PHOTO.png --center X,Y --radius R [--invert] [--closing N] [--mask OUT.png]\n"
+    "usage: granucal measure PHOTO.png... [--center X,Y --radius R] [--dark | --light] [--closing N]\n"
+    "                        [--max-sd F] [--mask OUT] [--surface NAME --rpm RPM [--csv-angle FILE]\n"
+    "                        [--csv-area FILE] [--skip-refused]]\n"
     "\n"
-    "Measure a photograph of the drum face as the paper does (sections 3.2.2-3.2.3):\n"
-    "the pixels inside the drum circle (centre X,Y and radius R in pixels, image y\n"
-    "downwards) are binarised with Otsu's automatic threshold, the powder dark on a\n"
-    "lighter drum (--invert for a light powder), closed with a disc of N pixels\n"
-    "(default 3) to remove pores and noise, and measured:\n"
-    "  csa_percent  occupied pixels over pixels inside the drum circle (eq. 20)\n"
+    "Measure photographs of the drum face as the paper does by hand (sections 3.2.2-3.2.3):\n"
+    "  csa_percent  powder pixels over pixels inside the drum circle (eq. 20)\n"
     "  angle_deg    angle to the horizontal of a line fitted to the free surface\n"
-    "               over the central 60 %% of its width\n"
-    "Prints one JSON object. --mask writes the binarised image for checking.\n";
+    "               over the central 60 %% of its width (angle_signed_deg: counter-\n"
+    "               clockwise positive, as granucal's simulations report it)\n"
+    "\n"
+    "The drum: without --center/--radius it is found (the strongest circle in the\n"
+    "picture, then the innermost edge concentric with it: the inside of the rim).\n"
+    "With them (pixels, image y downwards) it is moved onto the drum's inner edge\n"
+    "within 3 %% of R of the centre and 4 %% of the radius given. Either way the\n"
+    "circle used is printed (center, radius) and drawn in red in --mask.\n"
+    "The powder: two tones are told apart under uneven light (a threshold halfway\n"
+    "between planes fitted to each tone's grey levels); the powder is the tone that\n"
+    "lies lower in the drum (--dark or --light to say; --invert = --light); pores are\n"
+    "closed with a disc of N pixels (default 3); the largest piece is kept and the\n"
+    "holes in it filled. The surface: per column the top of the powder below the\n"
+    "drum's empty part, away from the wall, fitted with Tukey's biweight (GSL);\n"
+    "surface_fit_sd_px is its robust spread. A photo whose surface lies more than\n"
+    "F·R about the line (--max-sd, default 0.04) or that shows no surface is\n"
+    "refused: a message, and exit status 1.\n"
+    "\n"
+    "Prints one JSON object per photo; with several photos, one more with their mean\n"
+    "and standard deviation. --mask OUT writes the photo with the powder tinted, the\n"
+    "circle, the surface points used and the line (several photos: OUT is a\n"
+    "directory, one mask per photo under the photo's file name).\n"
+    "\n"
+    "From a video of the drum to the calibration's input files:\n"
+    "  ffmpeg -i run.mp4 -vf fps=2 frames/%%04d.png     # (crop first if the drum is small)\n"
+    "  granucal measure frames/*.png --surface PTFE --rpm 4 \\\n"
+    "      --csv-angle experiments/data/repose_angle.csv --csv-area experiments/data/occupied_area.csv\n"
+    "appends 'PTFE,4,<mean angle>,<sd>' to repose_angle.csv (surface,rpm,angle_deg,angle_sd_deg)\n"
+    "and 'PTFE,4,<mean CSA>,<sd>' to occupied_area.csv (surface,rpm,csa_percent,csa_sd_percent),\n"
+    "creating either with its header; a file that already has this surface and speed is left\n"
+    "alone (an error). The rows need at least 2 measured frames, and every frame measured\n"
+    "unless --skip-refused leaves the refused ones out (they are listed either way).\n"
+    "Check a few masks before trusting the numbers.\n";
+
+typedef struct measure_args {
+    exp_photo_opts opts;
+    exp_circle circle;
+    int circle_given;
+    const char *mask, *surface, *csv_angle, *csv_area;
+    double rpm;
+    int skip_refused;
+} measure_args;
 
 static int parse_pair(const char *s, double *a, double *b)
 {
@@ -32,39 +76,208 @@ static int parse_pair(const char *s, double *a, double *b)
     return end == p || *end != '\0';
 }
 
+static int parse_number(const char *s, double *out)
+{
+    char *end;
+    *out = strtod(s, &end);
+    return end == s || *end != '\0' || !isfinite(*out);
+}
+
+static int usage(const char *why)
+{
+    fprintf(stderr, "granucal measure: %s\n(granucal measure --help)\n", why);
+    return 2;
+}
+
+enum { OPT_SURFACE = 256, OPT_RPM, OPT_CSV_ANGLE, OPT_CSV_AREA, OPT_SKIP, OPT_MAX_SD };
+
+// 0: parsed; -1: --help printed; else the exit status of a usage error.
+static int parse_args(int argc, char **argv, measure_args *a)
+{
+    static const struct option opts[] = {
+        {"center", required_argument, 0, 'c'},  {"radius", required_argument, 0, 'r'},
+        {"invert", no_argument, 0, 'i'},        {"light", no_argument, 0, 'i'},
+        {"dark", no_argument, 0, 'd'},          {"closing", required_argument, 0, 'k'},
+        {"mask", required_argument, 0, 'm'},    {"help", no_argument, 0, 'h'},
+        {"surface", required_argument, 0, OPT_SURFACE}, {"rpm", required_argument, 0, OPT_RPM},
+        {"csv-angle", required_argument, 0, OPT_CSV_ANGLE}, {"csv-area", required_argument, 0, OPT_CSV_AREA},
+        {"skip-refused", no_argument, 0, OPT_SKIP}, {"max-sd", required_argument, 0, OPT_MAX_SD},
+        {0}};
+    double cx = NAN, cy = NAN, radius = NAN;
+    int c;
+    while ((c = getopt_long(argc, argv, "c:r:idk:m:h", opts, NULL)) != -1) {
+        char *end = NULL;
+        if (c == 'h') return printf(measure_help), -1;
+        if (c == 'c' && parse_pair(optarg, &cx, &cy)) return usage("--center X,Y: two numbers");
+        if (c == 'r' && (parse_number(optarg, &radius) || !(radius > 0))) return usage("--radius R: a positive number");
+        if (c == 'i') a->opts.tone = EXP_POWDER_LIGHT;
+        if (c == 'd') a->opts.tone = EXP_POWDER_DARK;
+        if (c == 'k' && ((a->opts.closing_px = (int)strtol(optarg, &end, 10)) < 0 || *end))
+            return usage("--closing N: pixels, 0 or more");
+        if (c == 'm') a->mask = optarg;
+        if (c == OPT_SURFACE) a->surface = optarg;
+        if (c == OPT_RPM && (parse_number(optarg, &a->rpm) || !(a->rpm > 0))) return usage("--rpm: a positive number");
+        if (c == OPT_CSV_ANGLE) a->csv_angle = optarg;
+        if (c == OPT_CSV_AREA) a->csv_area = optarg;
+        if (c == OPT_SKIP) a->skip_refused = 1;
+        if (c == OPT_MAX_SD && (parse_number(optarg, &a->opts.max_sd_fraction) || !(a->opts.max_sd_fraction > 0)))
+            return usage("--max-sd F: a positive fraction of the drum radius");
+        if (c == '?') return 2;
+    }
+    if (optind >= argc) return usage("no photo given");
+    if (isnan(cx) != isnan(radius)) return usage("--center and --radius go together (or neither: the drum is found)");
+    a->circle_given = !isnan(cx);
+    a->circle = (exp_circle){cx, cy, radius, 0};
+    if ((a->csv_angle || a->csv_area) && (!a->surface || !(a->rpm > 0)))
+        return usage("--csv-angle and --csv-area need --surface NAME and --rpm RPM");
+    return 0;
+}
+
+// A JSON string, quotes and backslashes escaped, control characters dropped.
+static void print_json_string(const char *s)
+{
+    putchar('"');
+    for (; *s; ++s) {
+        if (*s == '"' || *s == '\\') putchar('\\');
+        if ((unsigned char)*s >= 0x20) putchar(*s);
+    }
+    putchar('"');
+}
+
+static void print_result(const char *photo, const exp_photo_result *r, int given, int closing, int found)
+{
+    printf("{\"photo\": ");
+    print_json_string(photo);
+    if (found)
+        printf(", \"angle_deg\": %.3f, \"angle_signed_deg\": %.3f, \"surface_fit_sd_px\": %.3f, \"surface_points\": %d",
+               fabs(r->angle_deg), r->angle_deg, r->surface_sd_px, r->surface_points);
+    else printf(", \"angle_deg\": null");
+    printf(", \"csa_percent\": %.3f, \"center\": [%.2f, %.2f], \"radius\": %.2f, \"circle\": \"%s\", "
+           "\"circle_support\": %.2f, \"powder\": \"%s\", \"closing_px\": %d, \"surface_found\": %s}\n",
+           r->csa_percent, r->circle.cx, r->circle.cy, r->circle.r, given ? "given, refined" : "found",
+           r->circle.support, r->powder_dark ? "dark" : "light", closing, found ? "true" : "false");
+}
+
+static int write_mask(const measure_args *a, const char *photo, int several, const exp_photo_result *r)
+{
+    char path[4096], err[1024];
+    const char *name = strrchr(photo, '/');
+    if (several) snprintf(path, sizeof path, "%s/%s", a->mask, name ? name + 1 : photo);
+    else snprintf(path, sizeof path, "%s", a->mask);
+    if (exp_photo_write_mask(path, r, err, sizeof err)) return fprintf(stderr, "granucal measure: %s\n", err), 1;
+    return 0;
+}
+
+typedef struct frame_stats {
+    int frames, measured, failed;
+    double angle_sum, angle_sq, csa_sum, csa_sq;
+} frame_stats;
+
+static void add_frame(frame_stats *s, double angle, double csa)
+{
+    s->measured++;
+    s->angle_sum += angle, s->angle_sq += angle * angle;
+    s->csa_sum += csa, s->csa_sq += csa * csa;
+}
+
+static double mean_of(double sum, int n) { return n ? sum / n : NAN; }
+
+// Sample standard deviation over the frames (n - 1).
+static double sd_of(double sum, double sq, int n)
+{
+    return n > 1 ? sqrt(fmax(0, (sq - sum * sum / n) / (n - 1))) : NAN;
+}
+
+static int measure_one(const measure_args *a, const char *photo, int several, frame_stats *s)
+{
+    char err[1024];
+    exp_photo_result r;
+    s->frames++;
+    int rc = exp_photo_measure(photo, a->circle_given ? &a->circle : NULL, &a->opts, &r, err, sizeof err);
+    if (rc == EXP_PHOTO_ERROR) return fprintf(stderr, "granucal measure: %s\n", err), s->failed++, 1;
+    if (rc) fprintf(stderr, "granucal measure: refused %s\n", err), s->failed++;
+    else add_frame(s, fabs(r.angle_deg), r.csa_percent);
+    print_result(photo, &r, a->circle_given, a->opts.closing_px, rc == EXP_PHOTO_OK);
+    int bad = a->mask && write_mask(a, photo, several, &r);
+    exp_photo_result_free(&r);
+    return rc || bad;
+}
+
+// Append one row to a data file, with its header if the file is new. The
+// file as it stands must load, and hold no row for this surface and speed.
+static int append_row(const char *path, cal_data_kind kind, const char *surface, double rpm, double value, double sd)
+{
+    static const char *const headers[2] = {"surface,rpm,angle_deg,angle_sd_deg", "surface,rpm,csa_percent,csa_sd_percent"};
+    struct stat st;
+    int exists = stat(path, &st) == 0 && st.st_size > 0;
+    if (exists) {
+        cal_series s = {0};
+        char err[1024];
+        if (cal_series_load(&s, path, kind, err, sizeof err))
+            return fprintf(stderr, "granucal measure: not appending to %s: %s\n", path, err), 1;
+        int duplicate = 0;
+        for (size_t k = 0; k < s.count; ++k)
+            duplicate |= strcasecmp(s.points[k].surface, surface) == 0 && s.points[k].rpm == rpm;
+        cal_series_free(&s);
+        if (duplicate)
+            return fprintf(stderr, "granucal measure: %s already has a row for %s at %g rpm; not appending\n", path,
+                           surface, rpm), 1;
+    }
+    FILE *f = fopen(path, "a");
+    if (!f) return fprintf(stderr, "granucal measure: cannot open %s: %s\n", path, strerror(errno)), 1;
+    if (!exists) fprintf(f, "%s\n", headers[kind]);
+    int quote = strpbrk(surface, ",\"") != NULL;
+    fprintf(f, "%s%s%s,%g,%.2f,%.2f\n", quote ? "\"" : "", surface, quote ? "\"" : "", rpm, value, sd);
+    if (fclose(f)) return fprintf(stderr, "granucal measure: cannot write %s: %s\n", path, strerror(errno)), 1;
+    fprintf(stderr, "granucal measure: appended %s,%g,%.2f,%.2f to %s\n", surface, rpm, value, sd, path);
+    return 0;
+}
+
+static int write_rows(const measure_args *a, const frame_stats *s)
+{
+    if (!a->csv_angle && !a->csv_area) return 0;
+    if (s->failed && !a->skip_refused)
+        return fprintf(stderr, "granucal measure: %d of %d photos not measured: no rows written "
+                               "(--skip-refused leaves them out)\n", s->failed, s->frames), 1;
+    if (s->measured < 2)
+        return fprintf(stderr, "granucal measure: %d photo measured gives no spread: the rows need 2 or more\n",
+                       s->measured), 1;
+    if (strpbrk(a->surface, "\"\n\r"))
+        return fprintf(stderr, "granucal measure: --surface: no quotes or line breaks\n"), 1;
+    int rc = 0;
+    if (a->csv_angle)
+        rc |= append_row(a->csv_angle, CAL_DATA_ANGLE, a->surface, a->rpm, mean_of(s->angle_sum, s->measured),
+                         sd_of(s->angle_sum, s->angle_sq, s->measured));
+    if (a->csv_area)
+        rc |= append_row(a->csv_area, CAL_DATA_CSA, a->surface, a->rpm, mean_of(s->csa_sum, s->measured),
+                         sd_of(s->csa_sum, s->csa_sq, s->measured));
+    return rc;
+}
+
+static void print_summary(const frame_stats *s)
+{
+    printf("{\"frames\": %d, \"measured\": %d, \"angle_deg\": %.3f, \"angle_sd_deg\": %.3f, \"csa_percent\": %.3f, "
+           "\"csa_sd_percent\": %.3f}\n",
+           s->frames, s->measured, mean_of(s->angle_sum, s->measured), sd_of(s->angle_sum, s->angle_sq, s->measured),
+           mean_of(s->csa_sum, s->measured), sd_of(s->csa_sum, s->csa_sq, s->measured));
+}
+
 int cal_cmd_measure(int argc, char **argv)
 {
-    static const struct option opts[] = {{"center", required_argument, 0, 'c'}, {"radius", required_argument, 0, 'r'},
-                                         {"invert", no_argument, 0, 'i'},       {"closing", required_argument, 0, 'k'},
-                                         {"mask", required_argument, 0, 'm'},   {"help", no_argument, 0, 'h'},
-                                         {0}};
-    double cx = NAN, cy = NAN, radius = NAN;
-    int invert = 0, closing = 3, c;
-    const char *mask = NULL;
-    while ((c = getopt_long(argc, argv, "c:r:ik:m:h", opts, NULL)) != -1) {
-        if (c == 'h') return printf(measure_help), 0;
-        if (c == 'c' && parse_pair(optarg, &cx, &cy)) return fprintf(stderr, "granucal measure: --center X,Y\n"), 2;
-        if (c == 'r') radius = atof(optarg);
-        if (c == 'i') invert = 1;
-        if (c == 'k') closing = atoi(optarg);
-        if (c == 'm') mask = optarg;
-        if (c == '?') return fprintf(stderr, measure_help), 2;
-    }
-    if (optind != argc - 1 || isnan(cx) || !(radius > 0) || closing < 0)
-        return fprintf(stderr, measure_help), 2;
-    char err[1024];
-    double threshold = 0;
-    exp_raster *r = exp_read_photo(argv[optind], cx, cy, radius, invert, &threshold, err, sizeof err);
-    if (!r) return fprintf(stderr, "granucal measure: %s\n", err), 1;
-    exp_angle a;
-    int bad = exp_raster_close(r, closing);
-    double csa = exp_raster_csa_percent(r, radius);
-    int no_surface = exp_raster_surface_angle(r, radius, 0.6, &a);
-    if (mask && exp_write_raster_png(mask, r, err, sizeof err)) fprintf(stderr, "granucal measure: %s\n", err), bad = 1;
-    printf("{\"photo\": \"%s\", \"angle_deg\": %.3f, \"surface_fit_sd_px\": %.3f, \"csa_percent\": %.3f, "
-           "\"threshold\": %.0f, \"closing_px\": %d, \"surface_found\": %s}\n",
-           argv[optind], no_surface ? NAN : fabs(a.angle_deg), a.residual_sd, csa, threshold, closing,
-           no_surface ? "false" : "true");
-    exp_raster_free(r);
-    return bad || no_surface;
+    measure_args a = {.opts = exp_default_photo_opts()};
+    int rc = parse_args(argc, argv, &a);
+    if (rc) return rc < 0 ? 0 : rc;
+    int several = argc - optind > 1;
+    struct stat st;
+    if (a.mask && several && (stat(a.mask, &st) != 0 || !S_ISDIR(st.st_mode)))
+        return usage("--mask with several photos names an existing directory (one mask per photo)");
+    frame_stats s = {0};
+    int bad = 0;
+    for (int k = optind; k < argc; ++k) bad |= measure_one(&a, argv[k], several, &s);
+    if (several) print_summary(&s);
+    if (s.failed && s.frames > 1)
+        fprintf(stderr, "granucal measure: %d of %d photos not measured\n", s.failed, s.frames);
+    int rows = write_rows(&a, &s);
+    if (a.skip_refused && s.measured > 0) bad = 0;
+    return bad || rows;
 }

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int write_png(const char *path, const unsigned char *pixels, int w, int h, int channels, char *err, size_t len)
+int exp_write_png(const char *path, const unsigned char *pixels, int w, int h, int channels, char *err, size_t len)
 {
     png_image img;
     memset(&img, 0, sizeof img);
@@ -68,13 +68,12 @@ int exp_render_drum_png(const char *path, const dem_world *w, double drum_radius
         ramp(hi > lo ? (v - lo) / (hi - lo) : 0.5, rgb);
         disc(px, width, c + scale * g.position[i].x, c - scale * g.position[i].y, scale * g.radius[i], rgb);
     }
-    int rc = write_png(path, px, width, width, 3, err, len);
+    int rc = exp_write_png(path, px, width, width, 3, err, len);
     free(px);
     return rc;
 }
 
-// Otsu's threshold over a 256-bin histogram.
-static int otsu(const unsigned long hist[256])
+int exp_otsu_threshold(const unsigned long hist[256])
 {
     unsigned long total = 0;
     double sum = 0;
@@ -127,7 +126,7 @@ exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius
             if (x * x + y * y > radius * radius || px < 0 || py < 0 || px >= w || py >= h) continue;
             hist[gray[(size_t)py * w + px]]++;
         }
-    int t = otsu(hist);
+    int t = exp_otsu_threshold(hist);
     for (int j = 0; r && j < r->ny; ++j)
         for (int i = 0; i < r->nx; ++i) {
             double x = r->x0 + i + 0.5, y = r->y0 + j + 0.5;
@@ -148,7 +147,7 @@ int exp_write_raster_png(const char *path, const exp_raster *r, char *err, size_
     if (!px) return snprintf(err, len, "out of memory"), 1;
     for (int j = 0; j < r->ny; ++j)
         for (int i = 0; i < r->nx; ++i) px[(size_t)(r->ny - 1 - j) * r->nx + i] = r->occupied[(size_t)j * r->nx + i] ? 0 : 255;
-    int rc = write_png(path, px, r->nx, r->ny, 1, err, len);
+    int rc = exp_write_png(path, px, r->nx, r->ny, 1, err, len);
     free(px);
     return rc;
 }

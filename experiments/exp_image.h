@@ -27,6 +27,14 @@ int exp_render_drum_png(const char *path, const dem_world *w, double drum_radius
 exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius, int invert, double *threshold,
                            char *err, size_t len);
 
+/// Otsu's threshold over a 256-bin histogram: the grey level that
+/// separates the two classes with the largest between-class variance.
+int exp_otsu_threshold(const unsigned long hist[256]);
+
+/// Write 8-bit pixels (1 channel: grey, 3: RGB) as a PNG, through a
+/// temporary file renamed into place. 0, else a message naming the file.
+int exp_write_png(const char *path, const unsigned char *pixels, int w, int h, int channels, char *err, size_t len);
+
 /// Write a raster as a greyscale PNG (occupied black), for inspection.
 int exp_write_raster_png(const char *path, const exp_raster *r, char *err, size_t len);
 
