@@ -14,12 +14,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmocka.h>
 #include <math.h>
 #include <png.h>
 
+#include "cal_commands.h"
+#include "cal_data.h"
 #include "exp_photo.h"
 
 #define PI 3.14159265358979323846
@@ -326,13 +329,75 @@ static void test_refusals_and_bad_input(void **state)
     assert_non_null(strstr(err, path));
 }
 
+static int run_measure(int argc, char **argv)
+{
+    extern int optind;
+    optind = 0; // getopt starts afresh for each command
+    fflush(stdout);
+    return cal_cmd_measure(argc, argv);
+}
+
+static void expect_row(const char *path, cal_data_kind kind, double value, double sd)
+{
+    cal_series series = {0};
+    char err[1024];
+    if (cal_series_load(&series, path, kind, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(series.count, 1);
+    printf("%s: %s,%g,%.2f,%.2f (expected %.2f, %.2f)\n", path, series.points[0].surface, series.points[0].rpm,
+           series.points[0].value, series.points[0].sd, value, sd);
+    assert_string_equal(series.points[0].surface, "PTFE");
+    assert_true(series.points[0].rpm == 4);
+    assert_true(fabs(series.points[0].value - value) < 0.05 && fabs(series.points[0].sd - sd) < 0.05);
+    cal_series_free(&series);
+}
+
+// `granucal measure` on three frames (30, 31, 32 degrees; 44, 45, 46 %):
+// the rows experiments/data/ expects, mean and sample SD; a refused frame
+// stops the rows unless --skip-refused; a second run for the same surface
+// and speed is refused rather than appended.
+static void test_frames_to_data_rows(void **state)
+{
+    (void)state;
+    char frames[4][512], angle_csv[512], area_csv[512], mask_dir[512];
+    for (int k = 0; k < 3; ++k) {
+        scene s = base_scene();
+        s.angle_deg = 30 + k, s.fill = 0.44 + 0.01 * k, s.seed = 100 + k, s.rim_px = 8, s.rim = 30, s.pores = 0.03;
+        snprintf(frames[k], sizeof frames[k], "%s/%04d.png", tmpdir, k + 1);
+        render(&s, frames[k]);
+    }
+    scene wavy = base_scene();
+    wavy.wave_px = 40;
+    snprintf(frames[3], sizeof frames[3], "%s/wavy.png", tmpdir);
+    render(&wavy, frames[3]);
+    snprintf(angle_csv, sizeof angle_csv, "%s/repose_angle.csv", tmpdir);
+    snprintf(area_csv, sizeof area_csv, "%s/occupied_area.csv", tmpdir);
+    snprintf(mask_dir, sizeof mask_dir, "%s/masks", tmpdir);
+    assert_int_equal(mkdir(mask_dir, 0700), 0);
+    char *argv[] = {"measure", frames[0], frames[1], frames[2], frames[3], "--surface", "PTFE", "--rpm", "4",
+                    "--csv-angle", angle_csv, "--csv-area", area_csv, "--mask", mask_dir, "--skip-refused", NULL};
+    assert_int_equal(run_measure(15, argv), 1); // the wavy frame: refused, no rows
+    assert_int_not_equal(access(angle_csv, F_OK), 0);
+    assert_int_equal(run_measure(16, argv), 0); // left out
+    expect_row(angle_csv, CAL_DATA_ANGLE, 31, 1);
+    expect_row(area_csv, CAL_DATA_CSA, 45, 1);
+    assert_int_not_equal(run_measure(16, argv), 0); // PTFE at 4 rpm is there already
+    expect_row(angle_csv, CAL_DATA_ANGLE, 31, 1);
+    for (int k = 0; k < 4; ++k) {
+        char mask[1100];
+        snprintf(mask, sizeof mask, "%s/%s", mask_dir, strrchr(frames[k], '/') + 1);
+        assert_int_equal(access(mask, F_OK), 0);
+        remove(mask), remove(frames[k]);
+    }
+    rmdir(mask_dir), remove(angle_csv), remove(area_csv);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_issue_photo),   cmocka_unit_test(test_rims),
         cmocka_unit_test(test_circle_off),        cmocka_unit_test(test_pores_light_noise),
         cmocka_unit_test(test_angles_and_fills),  cmocka_unit_test(test_everything_at_once),
-        cmocka_unit_test(test_refusals_and_bad_input),
+        cmocka_unit_test(test_refusals_and_bad_input), cmocka_unit_test(test_frames_to_data_rows),
     };
     return cmocka_run_group_tests(tests, make_tmpdir, remove_tmpdir);
 }
