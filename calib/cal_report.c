@@ -13,6 +13,7 @@
 #include "cal_util.h"
 #include "dem_gsd.h"
 #include "exp_common.h"
+#include "exp_contact_rules.h"
 
 // ---- the table ---------------------------------------------------------------
 
@@ -36,8 +37,8 @@ static int table_rows(const cal_table *t, row *rows)
     rows[n++] = (row){"granule-granule", "", "xi", t->xi, "-", no_range};
     rows[n++] = (row){"granule-granule", "", "mu_s", t->gg_mu_s, "-", t->gg_mu_s_range};
     rows[n++] = (row){"granule-granule", "", "mu_r", t->gg_mu_r, "-", t->gg_mu_r_range};
-    // Table 3: a rigid boundary in series with the granule's own spring: 2 k_n.
-    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], 2 * t->k_n, "N/m", no_range};
+    const double k_boundary = exp_boundary_stiffness(t->k_n);
+    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], k_boundary, "N/m", no_range};
     rows[n++] = (row){"granule-boundary", "", "xi", t->xi, "-", no_range};
     for (int w = 0; w < t->n_walls; ++w) {
         rows[n] = (row){"granule-boundary", "", "mu_s", t->wall_mu_s[w], "-", t->wall_mu_s_range[w]};
@@ -86,7 +87,8 @@ static int write_table_md(const char *dir, const cal_table *t, char *err, size_t
     fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
     fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s | %s |\n", t->gg_mu_s, range_cell(g[0], t->gg_mu_s_range), t->gg_source);
     fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s | %s |\n", t->gg_mu_r, range_cell(g[1], t->gg_mu_r_range), t->gg_source);
-    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | | 2 k_n, springs in series (Table 3) |\n", 2 * t->k_n);
+    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | | 2 k_n, springs in series (Table 3) |\n",
+            exp_boundary_stiffness(t->k_n));
     fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
     for (int w = 0; w < t->n_walls; ++w)
         fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_s[w],
@@ -182,7 +184,7 @@ static void liggghts_entry(FILE *f, const cal_outcome *o, int p, int i, int j)
 {
     const cal_table *t = &o->table;
     int wall = (i == 0) != (j == 0), gg = i == 0 && j == 0, w = (i ? i : j) - 1;
-    double k = wall ? 2 * t->k_n : t->k_n; // wall-wall pairs never touch: any value
+    double k = wall ? exp_boundary_stiffness(t->k_n) : t->k_n; // wall-wall pairs never touch: any value
     if (p < 2) fprintf(f, " $(%.6g*v_gc_k)", k);
     else if (p == 2) fprintf(f, " $(%.6g*v_gc_g)", damping_rate(o->config, k, wall));
     else if (p == 3) fputs(" 0", f); // no tangential damping in the paper's model
@@ -257,7 +259,7 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
         for (char *p = name; *p; ++p)
             if (!isalnum((unsigned char)*p)) *p = '_';
         fprintf(f, "variable wall_%s string \"", name);
-        lammps_keywords(f, o->config, 2 * t->k_n, t->wall_mu_s[w], t->wall_mu_r[w], 1);
+        lammps_keywords(f, o->config, exp_boundary_stiffness(t->k_n), t->wall_mu_s[w], t->wall_mu_r[w], 1);
         fputs("\"\n", f);
     }
     return cal_atomic_commit(&a, err, len);

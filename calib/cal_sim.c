@@ -13,6 +13,16 @@
 #include "cal_util.h"
 #include "dem_checkpoint.h"
 #include "exp_common.h"
+#include "exp_contact_rules.h"
+
+// The config's damping reading (its name was checked when the config was loaded).
+static dem_damping_mode config_damping(const cal_config *c)
+{
+    dem_damping_mode mode = EXP_DAMPING_DEFAULT;
+    char unused[160];
+    exp_damping_from_name(c->damping, "damping", &mode, unused, sizeof unused);
+    return mode;
+}
 
 static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
                                double wall_mu_s, double wall_mu_r)
@@ -24,10 +34,8 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     d.def.depth = d.def.periodic ? t->slice_depth : c->depth;
     d.def.lambda = t->lambda, d.def.density = c->density, d.def.seed = (uint64_t)c->seed;
     d.def.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
-    int mode = c->damping ? dem_damping_mode_from_name(c->damping) : DEM_DAMPING_APPROACHING;
-    // Table 3: k_n = k_s = k_r; the boundary has twice the stiffness (springs in series).
-    d.def.granule = (dem_contact_params){k_n, k_n, k_n, c->xi, gg_mu_s, gg_mu_r, (dem_damping_mode)mode};
-    d.def.wall = (dem_contact_params){2 * k_n, 2 * k_n, 2 * k_n, c->xi, wall_mu_s, wall_mu_r, (dem_damping_mode)mode};
+    d.def.granule = exp_granule_pair(k_n, c->xi, gg_mu_s, gg_mu_r, config_damping(c));
+    d.def.wall = exp_boundary_pair(&d.def.granule, wall_mu_s, wall_mu_r);
     d.def.end_plate = d.def.wall;
     if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &d.def.fill_method); // checked on loading
     d.run = exp_default_drum_run_opts();
@@ -58,12 +66,11 @@ exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, 
     exp_cylinder_def d = exp_default_cylinder_def();
     d.lambda = t->cylinder_lambda, d.density = c->density, d.seed = seed;
     d.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
-    int mode = c->damping ? dem_damping_mode_from_name(c->damping) : DEM_DAMPING_APPROACHING;
     // Stage 1 comes before the friction is known: the pour uses the config's
     // stated prior friction (pour_mu_s, pour_mu_r). The stage reads how the
     // coordination number moves with k, not its level.
-    d.granule = (dem_contact_params){k_n, k_n, k_n, c->xi, c->pour_mu_s, c->pour_mu_r, (dem_damping_mode)mode};
-    d.wall = d.granule; // its stiffness is set to 2 k_n by exp_cylinder (Table 3)
+    d.granule = exp_granule_pair(k_n, c->xi, c->pour_mu_s, c->pour_mu_r, config_damping(c));
+    d.wall = d.granule; // exp_cylinder gives it Table 3's boundary stiffness
     return d;
 }
 

@@ -19,6 +19,7 @@
 // its plane point between steps, which is all the engine reads of a plane.
 // See move_piston: the one place that touches the engine's private layout.
 #include "dem_world_internal.h"
+#include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_pour.h"
 #include "exp_scene.h"
@@ -103,8 +104,8 @@ static dem_world *create_die(const exp_compress_def *d, double gravity, char *er
     def.domain_hi = dem_v3(1.2 * r, 4 * d->depth, 1.2 * r);
     dem_world *w = dem_world_create(&def, err, len);
     if (!w) return NULL;
-    dem_contact_params wall = d->wall;
-    wall.k_n = wall.k_s = wall.k_r = 2 * d->granule.k_n; // Table 3: springs in series
+    dem_contact_params wall = d->wall; // the die's friction and dashpot, as given
+    wall.k_n = wall.k_s = wall.k_r = exp_boundary_stiffness(d->granule.k_n);
     wall = dem_scale_contact(&wall, d->lambda);
     dem_wall_def side = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 1, 0}, .radius = r,
                          .contact = wall, .name = "die"};
@@ -131,7 +132,7 @@ static void wall_forces(const dem_world *w, const exp_compress_def *d, double pi
                         double *side)
 {
     dem_granules_view g = dem_world_granules(w);
-    double k = dem_scale_stiffness(2 * d->granule.k_n, d->lambda), r_die = 0.5 * d->diameter;
+    double k = dem_scale_stiffness(exp_boundary_stiffness(d->granule.k_n), d->lambda), r_die = 0.5 * d->diameter;
     double ft = 0, fb = 0, fs = 0;
     for (size_t i = 0; i < g.count; ++i) {
         double ri = g.radius[i], y = g.position[i].y;
@@ -412,10 +413,9 @@ static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t
     *d = exp_default_compress_def();
     d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
     d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
-    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
-    if (mode < 0) return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
-    // Section 3.2: k_n = k_s = k_r; no rolling here (μ_r = 0 switches it off).
-    d->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, 0, (dem_damping_mode)mode};
+    dem_damping_mode mode;
+    if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
+    d->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, 0, mode); // no rolling here (μ_r = 0 switches it off)
     d->wall = d->granule;
     d->wall.mu_s = y->wall_mu_s;
     d->sigma_min = y->sigma_min, d->sigma_max = y->sigma_max, d->piston_speed = y->piston_speed;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "dem_scaling.h"
+#include "exp_contact_rules.h"
 #include "exp_pour.h"
 
 #define LAYER_KE_RATIO 1e-2
@@ -38,8 +39,8 @@ static dem_world *create_container(const exp_cylinder_def *d, char *err, size_t 
     def.domain_hi = dem_v3(1.2 * r, 4 * d->depth, 1.2 * r);
     dem_world *w = dem_world_create(&def, err, len);
     if (!w) return NULL;
-    dem_contact_params wall = d->wall;
-    wall.k_n = wall.k_s = wall.k_r = 2 * d->granule.k_n; // Table 3: springs in series
+    dem_contact_params wall = d->wall; // the container's friction and dashpot, as given
+    wall.k_n = wall.k_s = wall.k_r = exp_boundary_stiffness(d->granule.k_n);
     wall = dem_scale_contact(&wall, d->lambda);
     dem_wall_def side = {.kind = DEM_WALL_CYLINDER, .point = {0, 0, 0}, .axis = {0, 1, 0}, .radius = r,
                          .contact = wall, .name = "container"};

@@ -13,6 +13,7 @@
 
 #include "dem_output.h"
 #include "dem_scaling.h"
+#include "exp_contact_rules.h"
 #include "exp_pour.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
@@ -69,13 +70,11 @@ static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t
     *d = exp_default_cylinder_def();
     d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
     d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
-    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
-    if (mode < 0)
-        return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
-    // Section 3.2: k_n = k_s = k_r. The container's friction is the granules'
-    // (as in the calibration's stage 1); exp_cylinder_run sets its stiffness
-    // to 2 k_n (Table 3: granule and wall springs in series).
-    d->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, y->mu_r, (dem_damping_mode)mode};
+    dem_damping_mode mode;
+    if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
+    // The container's friction is the granules' (as in the calibration's
+    // stage 1); exp_cylinder_run gives it Table 3's boundary stiffness.
+    d->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, y->mu_r, mode);
     d->wall = d->granule;
     d->seed = (uint64_t)y->seed;
     return 0;
@@ -199,7 +198,7 @@ void exp_cylinder_write_json(FILE *f, const exp_cylinder_def *d, const exp_cylin
             "{\"experiment\": \"cylinder\", \"status\": \"%s\", \"k_n\": %g, \"wall_k_n\": %g, \"mu_s\": %g, "
             "\"mu_r\": %g, \"xi\": %g, \"lambda\": %g, \"seed\": %llu, \"diameter_m\": %g, \"depth_m\": %g, "
             "\"granules\": %zu",
-            rep->ke_ratio < REST_KE_RATIO ? "ok" : "not at rest", d->granule.k_n, 2 * d->granule.k_n, d->granule.mu_s,
+            rep->ke_ratio < REST_KE_RATIO ? "ok" : "not at rest", d->granule.k_n, exp_boundary_stiffness(d->granule.k_n), d->granule.mu_s,
             d->granule.mu_r, d->granule.xi, d->lambda, (unsigned long long)d->seed, d->diameter, d->depth,
             r->granules);
     json_number(f, "coordination", r->coordination, "%.4f");

@@ -9,6 +9,7 @@
 
 #include "dem_checkpoint.h"
 #include "dem_scaling.h"
+#include "exp_contact_rules.h"
 #include "exp_pour.h"
 
 #define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
@@ -29,8 +30,7 @@ exp_drum_def exp_default_drum_def(void)
     d.gsd = dem_default_gsd();
     d.density = 1800;
     d.granule = dem_default_world_def().granule;
-    d.wall = d.granule;
-    d.wall.k_n = d.wall.k_s = d.wall.k_r = 2 * d.granule.k_n; // Table 3: springs in series
+    d.wall = exp_boundary_pair(&d.granule, d.granule.mu_s, d.granule.mu_r);
     d.end_plate = d.wall;
     d.pixel = 0;
     d.closing_px = 2;

@@ -6,6 +6,7 @@
 #include <cyaml/cyaml.h>
 
 #include "exp_common.h"
+#include "exp_contact_rules.h"
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -122,15 +123,15 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     def->depth = y->periodic ? y->slice_depth : y->depth;
     def->lambda = y->lambda, def->density = y->density, def->seed = (uint64_t)y->seed;
     def->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
-    int mode = y->damping ? dem_damping_mode_from_name(y->damping) : DEM_DAMPING_APPROACHING;
-    if (mode < 0) return exp_fail(err, len, "damping = '%s': use approaching, always, separating or no_tension", y->damping);
-    def->granule = (dem_contact_params){y->k_n, y->k_n, y->k_n, y->xi, y->mu_s, y->mu_r, (dem_damping_mode)mode};
-    def->wall = def->granule; // "granules": a lining of granules is a granular surface (assumption iii)
-    def->wall.k_n = def->wall.k_s = def->wall.k_r = 2 * y->k_n; // Table 3: springs in series
+    dem_damping_mode mode;
+    if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
+    def->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, y->mu_r, mode);
+    // "granules": a lining of granules is a granular surface (assumption iii)
+    def->wall = exp_boundary_pair(&def->granule, y->mu_s, y->mu_r);
     if (strcmp(y->wall, "granules") != 0) {
         const exp_material_yaml *m = find_material(y, y->wall);
         if (!m) return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
-        def->wall.mu_s = m->mu_s, def->wall.mu_r = m->mu_r;
+        def->wall = exp_boundary_pair(&def->granule, m->mu_s, m->mu_r);
     }
     def->end_plate = def->wall;
     if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &def->fill_method))

@@ -5,6 +5,7 @@
 #include <cyaml/cyaml.h>
 
 #include "exp_common.h"
+#include "exp_contact_rules.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -109,14 +110,10 @@ int exp_yaml_line_of(const char *path, const char *key, int from_line)
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len)
 {
-    *out = (dem_contact_params){y->k_n, y->k_s, y->k_r, y->xi, y->mu_s, y->mu_r, DEM_DAMPING_APPROACHING};
-    if (y->damping) {
-        int m = dem_damping_mode_from_name(y->damping);
-        if (m < 0)
-            return exp_fail(err, err_len, "%s.damping = '%s': unknown; use approaching, always, separating or no_tension",
-                        where, y->damping);
-        out->damping = (dem_damping_mode)m;
-    }
+    *out = (dem_contact_params){y->k_n, y->k_s, y->k_r, y->xi, y->mu_s, y->mu_r, EXP_DAMPING_DEFAULT};
+    char field[96];
+    snprintf(field, sizeof field, "%s.damping", where);
+    if (exp_damping_from_name(y->damping, field, &out->damping, err, err_len)) return 1;
     char sub[256];
     if (dem_contact_params_check(out, sub, sizeof sub)) return exp_fail(err, err_len, "%s.%s", where, sub);
     return 0;
