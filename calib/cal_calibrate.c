@@ -391,7 +391,7 @@ int cal_cmd_calibrate(int argc, char **argv)
     }
     if (status) fprintf(stderr, "granucal calibrate: %s\n", r->err);
     status = cal_mpi_any(status);
-    cal_sim_release(); // the bed kept between candidates
+    cal_sim_release(&r->env); // the bed kept between candidates
     cal_series_free(&r->angles), cal_series_free(&r->areas);
     free(r->granule);
     for (int w = 0; w < r->n_walls; ++w) free(r->walls[w]);

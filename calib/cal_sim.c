@@ -336,35 +336,30 @@ static void settled_and_turned(int i, int code, void *ctx)
         if (b->todo[j].c == b->case_todo[i]) show_run(b, b->todo[j], code, b->n_cases);
 }
 
-// The last settled bed and what defined it: the wall stage's candidates all
-// turn the same one (cal_drum_case_wall), so it is settled once per process.
-static struct {
-    char text[1024];
-    dem_world *bed;
-} kept;
+void cal_env_set_stage(cal_env *env, const char *stage) { snprintf(env->stage, sizeof env->stage, "%s", stage); }
 
-void cal_sim_release(void)
+void cal_sim_release(cal_env *env)
 {
-    dem_world_destroy(kept.bed);
-    kept.bed = NULL;
-    kept.text[0] = 0;
+    dem_world_destroy(env->kept_bed);
+    env->kept_bed = NULL;
+    env->kept_text[0] = 0;
 }
 
 // The settled bed of this fill definition: the kept one, or a new one (whose
 // wall time is then charged to the speeds turned now). NULL and a message
 // when the fill failed.
-static dem_world *settled_bed(const exp_drum_def *fill, double *wall_s, char *err, size_t len)
+static dem_world *settled_bed(cal_env *env, const exp_drum_def *fill, double *wall_s, char *err, size_t len)
 {
     char text[1024];
     drum_def_text(fill, text, sizeof text);
     *wall_s = 0;
-    if (kept.bed && strcmp(text, kept.text) == 0) return kept.bed;
-    cal_sim_release();
+    if (env->kept_bed && strcmp(text, env->kept_text) == 0) return env->kept_bed;
+    cal_sim_release(env);
     double t0 = exp_wall_seconds();
-    kept.bed = exp_drum_fill(fill, NULL, NULL, err, len);
+    env->kept_bed = exp_drum_fill(fill, NULL, NULL, err, len);
     *wall_s = exp_wall_seconds() - t0;
-    if (kept.bed) snprintf(kept.text, sizeof kept.text, "%s", text);
-    return kept.bed;
+    if (env->kept_bed) snprintf(env->kept_text, sizeof env->kept_text, "%s", text);
+    return env->kept_bed;
 }
 
 // 1 if every missing run (all ranks') settles the same bed.
@@ -387,7 +382,7 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
             if (i % size == rank) b->todo[b->n_todo++] = missing[i];
         if (b->n_todo == 0) return;
         char err[1024];
-        b->bed = settled_bed(&b->cases[b->todo[0].c].fill, &b->bed_wall_s, err, sizeof err);
+        b->bed = settled_bed(b->env, &b->cases[b->todo[0].c].fill, &b->bed_wall_s, err, sizeof err);
         if (!b->bed) {
             for (int i = 0; i < b->n_todo; ++i) write_failed(b->env, run_key(b, b->todo[i]), err);
             return;

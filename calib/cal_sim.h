@@ -21,14 +21,22 @@ typedef struct cal_env {
     int workers;        ///< processes per machine
     int use_fork;
     int tty;            ///< progress on a terminal
-    const char *stage;  ///< label of the current stage, for progress lines
+    char stage[64];     ///< label of the current stage, for progress lines
     double started;     ///< wall clock at the start of the calibration
     /// Wall seconds between a drum run's checkpoints in the store (0: none):
     /// a killed run, run again, resumes its turn from the last one.
     double checkpoint_every_s;
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
     cal_progress *progress;             ///< the whole calibration's, or NULL (a study, a single run)
+    /// The last settled bed and the text that defined it: the wall stage's
+    /// candidates all turn the same one (cal_drum_case_wall), so it is
+    /// settled once per process. Freed by cal_sim_release.
+    dem_world *kept_bed;
+    char kept_text[1024];
 } cal_env;
+
+/// Name the stage that progress lines are labelled with.
+void cal_env_set_stage(cal_env *env, const char *stage);
 
 /// Default wall seconds between a drum run's checkpoints: a kill costs at
 /// most this much turning, and a save (a few MB at λ 1000) is a small share.
@@ -60,7 +68,7 @@ cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double 
                                  double wall_mu_s, double wall_mu_r);
 
 /// Free the settled bed kept between candidates (at the end of a run).
-void cal_sim_release(void);
+void cal_sim_release(cal_env *env);
 
 /// The poured cylinder of stage 1 at stiffness k_n and seed.
 exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);

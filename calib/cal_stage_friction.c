@@ -399,10 +399,8 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
     out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
     out->angle_in_misfit = cal_tier_angle_in_misfit(t);
-    static char stage[64];
-    snprintf(stage, sizeof stage, "%s", material ? material->name : "granule");
-    env->stage = stage;
-    cal_progress_enter(env->progress, stage);
+    cal_env_set_stage(env, material ? material->name : "granule");
+    cal_progress_enter(env->progress, env->stage);
     search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
     if (set_targets(&s, angles, areas)) return 1;
     evaluate_grid(&s);
@@ -413,6 +411,6 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
     out->wall_time_s = exp_wall_seconds() - t0;
     if (s.failed) return 1;
-    if (out->best < 0) return exp_fail(err, len, "%s: every candidate failed; see simulations.csv", stage);
+    if (out->best < 0) return exp_fail(err, len, "%s: every candidate failed; see simulations.csv", env->stage);
     return 0;
 }

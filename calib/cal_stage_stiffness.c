@@ -79,7 +79,7 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
         for (int j = 0; j < seeds; ++j)
             cases[i * seeds + j] = cal_cylinder_case_make(c, t, c->stiffness[i], (uint64_t)(c->seed + j));
     }
-    env->stage = "stiffness";
+    cal_env_set_stage(env, "stiffness");
     cal_progress_enter(env->progress, env->stage);
     int bad = cal_cylinder_evaluate(env, cases, n * seeds, rec, err, len);
     if (!bad) {

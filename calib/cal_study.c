@@ -534,8 +534,8 @@ static int run_ladder(study *s)
                     r->predicted_s / 3600, (budget_s - spent) / 3600);
             continue;
         }
-        s->env.stage = rung->name;
-        cal_sim_release(); // each rung settles its own beds: its cost includes them
+        cal_env_set_stage(&s->env, rung->name);
+        cal_sim_release(&s->env); // each rung settles its own beds: its cost includes them
         fprintf(stderr, "[fidelity] %s: lambda %g, %s, %g s per speed, %d seed(s)%s\n", rung->name, rung->lambda,
                 rung->slice_depth > 0 ? "periodic slice" : "full drum", rung->max_time, f->seeds,
                 base ? "" : " (no prediction: first rung)");
@@ -586,7 +586,7 @@ int cal_cmd_study(int argc, char **argv)
     }
     if (status) fprintf(stderr, "granucal study: %s\n", s->err);
     status = cal_mpi_any(status);
-    cal_sim_release();
+    cal_sim_release(&s->env);
     if (s->c) cal_config_free(s->c);
     free(s);
     cal_mpi_finalize();
