@@ -352,7 +352,7 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     if (n == 0) return exp_fail(s->err, s->len, "%s: no angle of repose for surface '%s'", angles->path, r->surface);
     // A coarse tier measures a biased angle (the angle grows with the scale
     // factor, Table B.1); its measured offset moves the lab's target onto the
-    // tier's own scale (cal_tier.angle_offset_deg, README "Table 3 in CI").
+    // tier's own scale (cal_tier.angle_offset_deg, docs/calibration.md, "Table 3 in CI").
     r->angle_lab = pts[0]->value, r->angle_offset = s->t->angle_offset_deg;
     r->angle_target = r->angle_lab + r->angle_offset, r->angle_rpm = pts[0]->rpm;
     r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + s->t->angle_sd_deg * s->t->angle_sd_deg);

@@ -127,7 +127,7 @@ static void move_piston(dem_world *w, double y) { w->walls[WALL_PISTON].def.poin
 
 // Spring forces on the piston, the floor and the side wall: the normal
 // springs k_n·h of eq. 3 (the dashpot is left out: at the quasi-static rate
-// it is a small, rate-dependent part, see README).
+// it is a small, rate-dependent part, see docs/experiments.md).
 static void wall_forces(const dem_world *w, const exp_compress_def *d, double piston_y, double *top, double *bottom,
                         double *side)
 {

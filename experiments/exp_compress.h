@@ -25,7 +25,7 @@
 
 /// Definition of a compression run. Powder and contacts are for the REAL
 /// powder; eq. 15–18 are applied with `lambda`. The pressures are applied
-/// to the simulated (coarse) bed as they are (see README: E' of a coarse bed
+/// to the simulated (coarse) bed as they are (see docs/experiments.md: E' of a coarse bed
 /// at a fixed real k scales as λ^(−2/3)).
 typedef struct exp_compress_def {
     double diameter;     ///< die inner diameter, m (0.076)

@@ -12,8 +12,8 @@
 
 #include "dem_contact.h"
 
-/// The reading of eq. 4's dashpot a config gets when it names none (README
-/// "Contact model": damped while approaching, never pulling granules together).
+/// The reading of eq. 4's dashpot a config gets when it names none (docs/model.md,
+/// "The contact model": damped while approaching, never pulling granules together).
 #define EXP_DAMPING_DEFAULT DEM_DAMPING_APPROACHING
 
 /// A config's optional damping name (NULL: EXP_DAMPING_DEFAULT) into *out;

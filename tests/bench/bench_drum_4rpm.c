@@ -3,7 +3,7 @@
 // slice by bed volume, turn it, and print angle and CSA every 0.1 s with the
 // wall time. Usage: build/tests/bench_drum_4rpm LAMBDA SLICE_DEPTH_M RPM [live]
 // (a 5th argument: turn at the step of the settled bed's contact network)
-// (the README's 4 rpm figures: bench_drum_4rpm 4096 0.015 4).
+// (docs/experiments.md's 4 rpm figures: bench_drum_4rpm 4096 0.015 4).
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>

@@ -3,7 +3,7 @@
 //
 // The ci tier (configs/calibration.yaml) turns a lambda = 32768 drum, where
 // Table 3's pair piles 5.8 +- 2.5 deg steeper than the lab (four seeds of
-// `granucal study fidelity`; README "What accuracy costs in time"); its
+// `granucal study fidelity`; docs/fidelity.md); its
 // angle_offset_deg takes that bias out, so the run checks the pipeline, not
 // the coarse model's absolute angle. What the ci tier can then resolve is set
 // by its search, fixed before any run was compared with Table 3:

@@ -61,7 +61,7 @@ static void test_cycles_against_independent_estimates(void **state)
     char cycles[] = "cycles=3", *sets[] = {cycles};
     if (exp_compress_load(path, 1, sets, &d, err, sizeof err)) fail_msg("%s", err);
     // Half the die's diameter (a quarter of the granules) keeps the test
-    // within CI's few minutes; the shipped die is the README's run.
+    // within CI's few minutes; the shipped die is docs/experiments.md's run.
     d.diameter *= 0.5;
     exp_compress_result r;
     dem_world *w = exp_compress_run(&d, NULL, NULL, &r, err, sizeof err);

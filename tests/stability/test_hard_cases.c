@@ -783,7 +783,7 @@ static void test_determinism_and_threads(void **state)
     assert_true(dg.coordination >= 1.0); // a contact network for the pair loops, not a gas
     assert_true(bitwise_equal(a, b));
     // 1 against 2 threads from the same settled bed. Few steps: on a loaded
-    // machine libgomp's barriers cost milliseconds each (README), and any
+    // machine libgomp's barriers cost milliseconds each (docs/calibration.md, "OpenMP on a shared machine"), and any
     // thread-dependent rounding shows in the last bits at once. The tolerance
     // is zero, bitwise, because the engine promises it (dem_forces.c: per-pair
     // slots gathered in a fixed order, no floating-point reduction across

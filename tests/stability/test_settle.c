@@ -99,7 +99,7 @@ static void settle(const dem_gsd *gsd, const char *label)
     // Falls by many orders of magnitude, and stays there. It does not fall to
     // zero: the paper's model has no tangential damping, so rocking modes of
     // sticking contacts, which never move a normal dashpot, keep what energy
-    // they hold (see README) and trade it with the springs, so the KE of the
+    // they hold (see docs/verification.md) and trade it with the springs, so the KE of the
     // last 0.1 s swings by tens of per cent. A boiling bed (LIGGGHTS at 0.6
     // dt_crit: granules at 1-2 m/s) grows by orders of magnitude instead:
     // the last 0.1 s must stay within 10x of where it started.
