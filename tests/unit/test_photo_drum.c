@@ -28,9 +28,10 @@ static void test_rendered_frames_match_the_raster(void **state)
     char config[1024], err[1024], dir[] = "/tmp/granucal_photo_drum_XXXXXX";
     const char *src = getenv("GRANUCAL_SOURCE_DIR");
     snprintf(config, sizeof config, "%s/configs/drum.yaml", src ? src : ".");
-    // The coarse bed of tests/experiments/test_drum.c: a few hundred granules, filled in seconds.
-    char *sets[] = {"lambda=16384", "slice_depth=0.025"};
-    exp_drum_yaml *y = exp_drum_config_load(config, 2, sets, err, sizeof err);
+    // The coarse bed of tests/experiments/test_drum.c (a few hundred granules), packed rather than
+    // poured: filled and settled in seconds (half the pour's time).
+    char *sets[] = {"lambda=16384", "slice_depth=0.025", "fill_method=pack"};
+    exp_drum_yaml *y = exp_drum_config_load(config, 3, sets, err, sizeof err);
     if (!y) fail_msg("%s", err);
     exp_drum_def d;
     exp_drum_run_opts run;
@@ -38,7 +39,7 @@ static void test_rendered_frames_match_the_raster(void **state)
     dem_world *w = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
     if (!w) fail_msg("%s", err);
     assert_non_null(mkdtemp(dir));
-    // The picture's scale (exp_render_drum_png): the drum is FRAME_PX / 2.1 across... its radius in pixels.
+    // The picture's scale (exp_render_drum_png draws 2.1 drum radii across FRAME_PX).
     double radius_m = 0.5 * d.diameter, scale = FRAME_PX / (2.1 * radius_m), pixel = 0.25 * d.gsd.median_diameter * cbrt(d.lambda);
     // Closing as the simulation's raster: closing_px of its pixels, in the picture's pixels.
     exp_photo_opts o = exp_default_photo_opts();
