@@ -150,6 +150,37 @@ static int write_table_h5(const char *dir, const row *rows, int n, char *err, si
 
 // ---- the table for other codes -------------------------------------------------
 
+// What each export leaves out of the paper's model: written into its file's
+// header and into report.md.
+static const char *const liggghts_differences[] = {
+    "hooke/stiffness damps with gamman*m_eff per type pair; the paper's 2*xi*sqrt(m* k) depends on each\n"
+    "pair's m*. Its gamman is exact for two median granules (and for wall contacts of one).",
+    "the dashpot acts while the granules part too; the paper's eq. 4 switch has no counterpart.",
+    "rolling_friction epsd2 never turns its rolling spring onto the new tangent plane, and sets its\n"
+    "rolling stiffness from kt; the paper (and granucal) carry it and use k_r = k_n.",
+    "LIGGGHTS 3.8 needs dt <= ~0.35 dt_crit to keep a dense bed at rest with xi = 0.7.",
+    NULL};
+static const char *const lammps_differences[] = {
+    "damping mass_velocity takes one rate per type pair (gamma/m*, exact for two median granules and\n"
+    "for a wall and one).",
+    "the dashpot acts while the granules part too (the paper's eq. 4 switch has no counterpart).",
+    "rolling sds has its own spring history (carried like the paper's).",
+    "no tangential damping (xgammat = 0), as in the paper's model.",
+    NULL};
+
+// The list as "- item" lines, each continuation line under `indent`.
+static void write_differences(FILE *f, const char *const *items, const char *bullet, const char *indent)
+{
+    for (; *items; ++items) {
+        fputs(bullet, f);
+        for (const char *c = *items; *c; ++c) {
+            fputc(*c, f);
+            if (*c == '\n') fputs(indent, f);
+        }
+        fputc('\n', f);
+    }
+}
+
 // The paper's dashpot is γ_n = 2ξ sqrt(m* k) (eq. 5); LIGGGHTS' hooke/stiffness
 // (absolute_damping off) and LAMMPS' mass_velocity damping take one rate per
 // type pair, γ/m* = 2ξ sqrt(k/m*), and multiply it by the contact's own m*.
@@ -203,14 +234,8 @@ static int write_liggghts(const char *dir, const cal_outcome *o, char *err, size
     int n = 1 + t->n_walls;
     fprintf(f, "# granucal %s: calibrated parameters for LIGGGHTS 3.8.\n# atom type 1 = granules", exp_version());
     for (int w = 0; w < t->n_walls; ++w) fprintf(f, ", %d = %s wall", w + 2, t->wall_name[w]);
-    fprintf(f, " (a wall: fix wall/gran ... primitive type N, same model keywords)\n"
-               "# Differences from the paper's model:\n"
-               "#  - hooke/stiffness damps with gamman*m_eff per type pair; the paper's 2*xi*sqrt(m* k) depends on each\n"
-               "#    pair's m*. gamman below is exact for two median granules (and for wall contacts of one).\n"
-               "#  - the dashpot acts while the granules part too; the paper's eq. 4 switch has no counterpart.\n"
-               "#  - rolling_friction epsd2 never turns its rolling spring onto the new tangent plane, and sets its\n"
-               "#    rolling stiffness from kt; the paper (and granucal) carry it and use k_r = k_n.\n"
-               "#  - LIGGGHTS 3.8 needs dt <= ~0.35 dt_crit to keep a dense bed at rest with xi = 0.7.\n");
+    fputs(" (a wall: fix wall/gran ... primitive type N, same model keywords)\n# Differences from the paper's model:\n", f);
+    write_differences(f, liggghts_differences, "#  - ", "#    ");
     write_scaling(f, t);
     fputs("pair_style gran model hooke/stiffness tangential history rolling_friction epsd2 absolute_damping off\n"
           "pair_coeff * *\n", f);
@@ -242,12 +267,9 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     fprintf(f, "# granucal %s: calibrated parameters for LAMMPS pair_style granular.\n"
-               "# Differences from the paper's model: damping mass_velocity takes one rate per type pair\n"
-               "# (gamma/m*, exact for two median granules and for a wall and one); the dashpot acts while the\n"
-               "# granules part too (the paper's eq. 4 switch has no counterpart); rolling sds has its own spring\n"
-               "# history (carried like the paper's); no tangential damping (xgammat = 0).\n"
-               "# Walls: fix ID all wall/gran/region granular ${wall_<material>} region R\n",
-            exp_version());
+               "# Differences from the paper's model:\n", exp_version());
+    write_differences(f, lammps_differences, "#  - ", "#    ");
+    fputs("# Walls: fix ID all wall/gran/region granular ${wall_<material>} region R\n", f);
     write_scaling(f, t);
     fputs("pair_style granular\npair_coeff 1 1 ", f);
     lammps_keywords(f, o->config, t->k_n, t->gg_mu_s, t->gg_mu_r, 0);
@@ -410,6 +432,31 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
     report_identified(f, r, bounds);
 }
 
+// The exported tables: what they leave out, and the peers check of DIR/peers
+// when one was run on this table (tests/peers/drum_peers.sh writes its summary.txt).
+static void report_export(FILE *f, const char *dir)
+{
+    fputs("\n## The table in LIGGGHTS and LAMMPS\n\n`liggghts_parameters.in` (LIGGGHTS 3.8) leaves out of the paper's "
+          "model:\n\n", f);
+    write_differences(f, liggghts_differences, "- ", "  ");
+    fputs("\n`lammps_parameters.in` (LAMMPS `pair_style granular`):\n\n", f);
+    write_differences(f, lammps_differences, "- ", "  ");
+    char path[1200], line[512];
+    snprintf(path, sizeof path, "%s/peers/summary.txt", dir);
+    FILE *s = fopen(path, "r");
+    if (!s) {
+        fprintf(f, "\nNo peers check was run on this table. `TABLE=%s/calibrated_parameters.csv bash "
+                   "tests/peers/drum_peers.sh build/granucal build/tests/drum_peers %s/peers` runs both files as "
+                   "written on the ci drum slice beside granucal and measures them alike; the report then shows its "
+                   "numbers. At the ci table: `results/peers/README.md`.\n", dir, dir);
+        return;
+    }
+    fputs("\nThe peers check run on this table (`tests/peers/drum_peers.sh`, its `peers/summary.txt`):\n\n```\n", f);
+    while (fgets(line, sizeof line, s)) fputs(line, f);
+    fputs("```\n", f);
+    fclose(s);
+}
+
 static int write_report(const char *dir, const cal_outcome *o, char *err, size_t len)
 {
     char path[1200];
@@ -447,6 +494,7 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
     }
     if (o->granule) report_friction(f, o->granule, &o->config->granule);
     for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w], &o->config->wall);
+    report_export(f, dir);
     return cal_atomic_commit(&a, err, len);
 }
 
