@@ -21,7 +21,7 @@
 #include <hdf5_hl.h>
 
 #include "dem_h5_errors.h"
-#include "dem_world_internal.h"
+#include "dem_state_internal.h"
 
 // Bump when the meaning of a saved array changes without a change of size
 // in the structures named in layout_text.
@@ -84,7 +84,7 @@ static void zero_pointers(dem_world *s)
     s->pair_f = s->pair_ti = s->pair_tj = s->pair_n = NULL, s->pair_g = NULL;
     s->rev_start = s->rev_pair = NULL;
     memset(&s->nl_old, 0, sizeof s->nl_old);
-    memset(&s->imp, 0, sizeof s->imp);
+    s->imp = NULL;
     s->nl.start = NULL, s->nl.j = s->nl.row = NULL, s->nl.constants = NULL, s->nl.hist = NULL;
     for (int k = 0; k < DEM_MAX_WALLS; ++k) s->walls[k].hist = NULL, s->walls[k].near = NULL, s->walls[k].def.name = NULL;
 }

@@ -2,7 +2,7 @@
 // Diagnostics of the current state: contacts, coordination number, kinetic
 // and elastic energy, largest overlap. Read-only; called once per output
 // interval, never inside the step loop.
-#include "dem_world_internal.h"
+#include "dem_state_internal.h"
 
 static double spring_energy(const double *hist, unsigned features, const dem_contact_params *p)
 {

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dem_world_internal.h"
+#include "dem_lists_internal.h"
 
 #define MORTON_BITS 21 // per axis: 63 bits of key
 
@@ -138,6 +138,6 @@ dem_status dem_world_sort_spatially(dem_world *w)
         dem_world_set_error(w, "out of memory sorting the granules");
         return DEM_ERR_NOMEM;
     }
-    if (w->prepared && dem_nl_rebuild(w)) return DEM_ERR_NOMEM;
+    if (w->prepared && dem_lists_rebuild(w)) return DEM_ERR_NOMEM;
     return DEM_OK;
 }

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: MIT
-// Power iteration on the linearised contact operators; see dem_stability.h.
+// Power iteration on the linearised contact operators of a contact network;
+// see dem_stability.h. A pure function of the network: no world here.
 #include "dem_stability.h"
 
 #include <float.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "dem_world_internal.h"
 
 #define POWER_ITERATIONS 200
 #define LATTICE_CELLS 4
@@ -18,41 +18,6 @@ typedef struct dof6 {
     dem_vec3 u, t;
 } dof6;
 
-typedef struct contact_geo {
-    size_t i, j; // j == SIZE_MAX: a wall
-    dem_vec3 n;
-    double ai, aj, rstar, mstar;
-    const dem_contact_params *p;
-} contact_geo;
-
-static size_t collect_contacts(dem_world *w, contact_geo **out)
-{
-    size_t cap = w->nl.count + w->n * (size_t)w->n_walls + 1, m = 0;
-    contact_geo *c = malloc(cap * sizeof *c);
-    if (!c) return 0;
-    for (size_t i = 0; i < w->n; ++i)
-        for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
-            size_t j = w->nl.j[k];
-            dem_vec3 d = dem_world_min_image(w, dem_v3_sub(w->pos[j], w->pos[i]));
-            double dist = dem_v3_norm(d), h = w->rad[i] + w->rad[j] - dist;
-            if (!(h > 0) || dist <= 0) continue;
-            c[m++] = (contact_geo){i, j, dem_v3_scale(d, 1 / dist), w->rad[i] - 0.5 * w->lever_factor * h,
-                                   w->rad[j] - 0.5 * w->lever_factor * h, w->rad[i] * w->rad[j] / (w->rad[i] + w->rad[j]),
-                                   1 / (w->inv_mass[i] + w->inv_mass[j]), &w->def.granule};
-        }
-    for (int k = 0; k < w->n_walls; ++k)
-        for (size_t i = 0; i < w->n; ++i) {
-            dem_wall_touch t = dem_wall_geometry(&w->walls[k].def, w->pos[i], w->rad[i]);
-            double h = t.overlap;
-            dem_vec3 n = t.normal;
-            if (!(h > 0)) continue;
-            c[m++] = (contact_geo){i, SIZE_MAX, n, w->rad[i] - w->lever_factor * h, 0, w->rad[i], w->mass[i],
-                                   &w->walls[k].def.contact};
-        }
-    *out = c;
-    return m;
-}
-
 // Which linearised operator `apply` forms.
 enum op_kind {
     OP_STIFFNESS = 0, // K: normal, sticking tangential and rolling springs
@@ -61,16 +26,17 @@ enum op_kind {
 };
 
 // y = K x, C x or K_n x, mass-normalised.
-static void apply(const dem_world *w, const contact_geo *c, size_t m, const dof6 *x, dof6 *y, enum op_kind op)
+static void apply(const dem_contact_network *net, const dof6 *x, dof6 *y, enum op_kind op)
 {
     const int dashpot = op == OP_DASHPOT;
-    memset(y, 0, w->n * sizeof *y);
-    for (size_t k = 0; k < m; ++k) {
-        const contact_geo *g = &c[k];
+    const double *mass = net->mass, *inertia = net->inertia;
+    memset(y, 0, net->granules * sizeof *y);
+    for (size_t k = 0; k < net->count; ++k) {
+        const dem_network_contact *g = &net->contact[k];
         size_t i = g->i, j = g->j;
         int wall = j == SIZE_MAX;
-        double si = 1 / sqrt(w->mass[i]), ri = 1 / sqrt(w->inertia[i]);
-        double sj = wall ? 0 : 1 / sqrt(w->mass[j]), rj = wall ? 0 : 1 / sqrt(w->inertia[j]);
+        double si = 1 / sqrt(mass[i]), ri = 1 / sqrt(inertia[i]);
+        double sj = wall ? 0 : 1 / sqrt(mass[j]), rj = wall ? 0 : 1 / sqrt(inertia[j]);
         dem_vec3 ui = dem_v3_scale(x[i].u, si), ti = dem_v3_scale(x[i].t, ri);
         dem_vec3 uj = wall ? dem_v3(0, 0, 0) : dem_v3_scale(x[j].u, sj);
         dem_vec3 tj = wall ? dem_v3(0, 0, 0) : dem_v3_scale(x[j].t, rj);
@@ -109,9 +75,9 @@ static double dot6(const dof6 *a, const dof6 *b, size_t n)
 }
 
 // Largest eigenvalue of a symmetric positive semi-definite operator.
-static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_t m, enum op_kind op)
+static double largest_eigenvalue(const dem_contact_network *net, enum op_kind op)
 {
-    size_t n = w->n;
+    size_t n = net->granules;
     dof6 *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
     if (!x || !y) {
         free(x), free(y);
@@ -128,7 +94,7 @@ static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_
         double norm = sqrt(dot6(x, x, n));
         if (norm == 0) break;
         for (size_t k = 0; k < 6 * n; ++k) xs[k] /= norm;
-        apply(w, c, m, x, y, op);
+        apply(net, x, y, op);
         double next = dot6(x, y, n); // Rayleigh quotient
         dof6 *t = x;
         x = y, y = t, xs = (double *)x;
@@ -142,29 +108,20 @@ static double largest_eigenvalue(const dem_world *w, const contact_geo *c, size_
     return lambda;
 }
 
-static int switches(const dem_contact_params *p) { return p->xi > 0 && p->damping != DEM_DAMPING_ALWAYS; }
-
-// Whether any dashpot of the world is switched on and off within a contact.
-static int dashpot_switches(const dem_world *w)
-{
-    int s = switches(&w->def.granule);
-    for (int k = 0; k < w->n_walls; ++k) s |= switches(&w->walls[k].def.contact);
-    return s;
-}
-
 // Implicit springs (dem_world_def.implicit_springs): the limit is the normal
 // springs' own, ω_n·Δt < 2 (proof in dem_stability.h); the sticking
 // tangential and rolling springs and the dashpots do not enter it.
-static dem_stability limit_implicit_springs(const dem_world *w, const contact_geo *c, size_t m, double dt_crit)
+static dem_stability limit_implicit_springs(const dem_contact_network *net, const dem_integration *how, double dt_crit)
 {
     dem_stability st = {0};
     st.dt_crit = dt_crit;
-    double k = m ? largest_eigenvalue(w, c, m, OP_NORMAL) : 0;
+    const size_t m = net->count;
+    double k = m ? largest_eigenvalue(net, OP_NORMAL) : 0;
     // A dashpot switched by the sign of v_rel,n (eq. 4 read as approaching or
     // separating; no_tension switches it off at zero force) pumps the mode
     // once it turns by more than 120° a step: ω_n·Δt < √3, for any ξ
     // (measured on one contact; 2 for a dashpot that never switches).
-    const double bound = dashpot_switches(w) ? sqrt(3.0) : 2.0;
+    const double bound = how->dashpot_switches ? sqrt(3.0) : 2.0;
     st.omega_max = sqrt(k > 0 ? k : 0);
     st.dt_limit = st.omega_max > 0 ? bound / st.omega_max : DBL_MAX;
     snprintf(st.why, sizeof st.why, "%zu contacts; implicit springs: %s/omega_n, omega_n = %.4g rad/s", m,
@@ -172,25 +129,15 @@ static dem_stability limit_implicit_springs(const dem_world *w, const contact_ge
     return st;
 }
 
-dem_stability dem_stability_of_network(dem_world *w, double dt_crit)
+dem_stability dem_stability_of_network(const dem_contact_network *net, const dem_integration *how, double dt_crit)
 {
+    if (how->implicit_springs) return limit_implicit_springs(net, how, dt_crit);
     dem_stability st = {0};
     st.dt_crit = dt_crit;
-    if (!w->list_valid && w->n) {
-        if (w->skin <= 0) w->skin = 0.4 * dem_world_min_radius(w);
-        if (dem_nl_rebuild(w)) return st;
-    }
-    contact_geo *c = NULL;
-    size_t m = collect_contacts(w, &c);
-    if (w->def.implicit_springs) {
-        st = limit_implicit_springs(w, c, m, dt_crit);
-        free(c);
-        return st;
-    }
+    const size_t m = net->count;
     // With the implicit dashpot the dashpot leaves the limit: ω·dt < 2.
-    double k = m ? largest_eigenvalue(w, c, m, OP_STIFFNESS) : 0;
-    double d = m && !w->def.implicit_damping ? largest_eigenvalue(w, c, m, OP_DASHPOT) : 0;
-    free(c);
+    double k = m ? largest_eigenvalue(net, OP_STIFFNESS) : 0;
+    double d = m && !how->implicit_damping ? largest_eigenvalue(net, OP_DASHPOT) : 0;
     st.omega_max = sqrt(k > 0 ? k : 0);
     st.damping_max = d > 0 ? d : 0;
     double denom = sqrt(4 * k + d * d) + d;
@@ -200,65 +147,71 @@ dem_stability dem_stability_of_network(dem_world *w, double dt_crit)
     return st;
 }
 
-static dem_contact_params stiffest(const dem_world *w)
-{
-    dem_contact_params p = w->def.granule;
-    // A granule on a wall of stiffness k_w moves like one in a pair of
-    // stiffness k_w/2 between equals, so walls enter at half their stiffness.
-    for (int k = 0; k < w->n_walls; ++k) {
-        const dem_contact_params *q = &w->walls[k].def.contact;
-        p.k_n = fmax(p.k_n, 0.5 * q->k_n);
-        p.k_s = fmax(p.k_s, 0.5 * q->k_s);
-        p.k_r = fmax(p.k_r, 0.5 * q->k_r);
-        p.xi = fmax(p.xi, q->xi);
-    }
-    // A switching wall dashpot bounds the implicit-spring step like one of the granules'.
-    if (dashpot_switches(w) && p.damping == DEM_DAMPING_ALWAYS) p.damping = DEM_DAMPING_APPROACHING;
-    return p;
-}
+// The cluster's granules: LATTICE_CELLS³ cells of 4, nearest neighbours at
+// 2R(1 − 1e-6), so every one of them is in contact. Masses and inertias in
+// the arithmetic of dem_world_add_granule, the granules in the order the
+// cluster was once added to a world in: the limit is bitwise that of such a
+// world's network.
+#define FCC_GRANULES (4 * LATTICE_CELLS * LATTICE_CELLS * LATTICE_CELLS)
+typedef struct fcc_cluster {
+    dem_vec3 pos[FCC_GRANULES];
+    double mass[FCC_GRANULES], inertia[FCC_GRANULES], inv_mass[FCC_GRANULES];
+} fcc_cluster;
 
-static void add_fcc_cluster(dem_world *lat, double radius, double density)
+static void fcc_place(fcc_cluster *c, double radius, double density)
 {
-    // Nearest neighbours at 2R(1 − 1e-6): every one of them is in contact.
     double a = 2 * radius * (1 - 1e-6) * sqrt(2.0);
     const double basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+    size_t i = 0;
     for (int x = 0; x < LATTICE_CELLS; ++x)
         for (int y = 0; y < LATTICE_CELLS; ++y)
             for (int z = 0; z < LATTICE_CELLS; ++z)
-                for (int b = 0; b < 4; ++b)
-                    dem_world_add_granule(lat, dem_v3(a * (x + basis[b][0]), a * (y + basis[b][1]), a * (z + basis[b][2])),
-                                          dem_v3(0, 0, 0), dem_v3(0, 0, 0), radius, density);
+                for (int b = 0; b < 4; ++b, ++i) {
+                    c->pos[i] = dem_v3(a * (x + basis[b][0]), a * (y + basis[b][1]), a * (z + basis[b][2]));
+                    double m = density * 4.0 / 3.0 * DEM_PI * radius * radius * radius;
+                    c->mass[i] = m;
+                    c->inertia[i] = 0.4 * m * radius * radius; // solid sphere
+                    c->inv_mass[i] = 1.0 / m;
+                }
 }
 
-dem_stability dem_stability_apriori(const dem_world *w)
+// The cluster's touching pairs, i < j in ascending order (as a neighbour
+// list's rows, sorted by partner, give them), into out; their count.
+static size_t fcc_contacts(const fcc_cluster *c, double radius, double lever_factor, const dem_contact_params *p,
+                           dem_network_contact *out)
 {
-    double m_min = dem_world_min_mass(w), r_min = dem_world_min_radius(w);
-    double dt_crit = sqrt(m_min / w->def.granule.k_n);
-    dem_world_def def = dem_default_world_def();
-    def.granule = stiffest(w);
-    // Sticking springs are the worst case: friction never truncates them here.
-    def.granule.mu_s = def.granule.mu_r = 1e300;
-    def.lever_arm = w->def.lever_arm;
-    def.implicit_damping = w->def.implicit_damping;
-    def.implicit_springs = w->def.implicit_springs;
-    def.domain_lo = dem_v3(-r_min, -r_min, -r_min);
-    def.domain_hi = dem_v3_scale(dem_v3(1, 1, 1), 2 * r_min * (LATTICE_CELLS * 1.5 + 1));
-    dem_world *lat = dem_world_create(&def, NULL, 0);
+    size_t m = 0;
+    for (size_t i = 0; i < FCC_GRANULES; ++i)
+        for (size_t j = i + 1; j < FCC_GRANULES; ++j) {
+            dem_vec3 d = dem_v3_sub(c->pos[j], c->pos[i]);
+            double dist = dem_v3_norm(d), h = radius + radius - dist;
+            if (!(h > 0) || dist <= 0) continue;
+            out[m++] = (dem_network_contact){i, j, dem_v3_scale(d, 1 / dist), radius - 0.5 * lever_factor * h,
+                                             radius - 0.5 * lever_factor * h, radius * radius / (radius + radius),
+                                             1 / (c->inv_mass[i] + c->inv_mass[j]), p};
+        }
+    return m;
+}
+
+dem_stability dem_stability_fcc(const dem_contact_params *p, double lever_factor, const dem_integration *how,
+                                double m_min, double r_min, double dt_crit)
+{
     dem_stability st = {0};
-    if (!lat) return st;
+    fcc_cluster *c = malloc(sizeof *c);
+    dem_network_contact *contact = malloc(6 * FCC_GRANULES * sizeof *contact); // 12 each, each pair once
+    if (!c || !contact) {
+        free(c), free(contact);
+        return st;
+    }
     double density = m_min / (4.0 / 3.0 * DEM_PI * r_min * r_min * r_min);
-    add_fcc_cluster(lat, r_min, density);
-    st = dem_stability_of_network(lat, dt_crit);
-    dem_world_destroy(lat);
+    fcc_place(c, r_min, density);
+    const dem_contact_network net = {FCC_GRANULES, c->mass, c->inertia,
+                                     fcc_contacts(c, r_min, lever_factor, p, contact), contact};
+    st = dem_stability_of_network(&net, how, dt_crit);
+    free(c), free(contact);
     char inner[100];
     snprintf(inner, sizeof inner, "%.99s", st.why);
     snprintf(st.why, sizeof st.why, "densest cluster of the lightest granules (FCC, 12 sticking contacts; %.99s)",
              inner);
     return st;
-}
-
-dem_stability dem_stability_current(dem_world *w)
-{
-    double dt_crit = w->n ? sqrt(dem_world_min_mass(w) / w->def.granule.k_n) : 0;
-    return dem_stability_of_network(w, dt_crit);
 }

@@ -28,16 +28,50 @@ typedef struct dem_stability {
     char why[200];       ///< what network the limit was computed for
 } dem_stability;
 
-/// Limit for the scene before it runs: a dense face-centred-cubic cluster
-/// (12 contacts each, the most an equal sphere can have) of the scene's
-/// lightest granules, with the stiffest of the granule and wall springs, all
-/// sticking. Conservative: heavier neighbours only lower the frequencies.
+/// One contact of a network, linearised about its current geometry: granule
+/// i against granule j, or against a wall (j = SIZE_MAX: a partner of
+/// infinite mass); unit normal n from i towards the partner, lever arms ai
+/// and aj, R*, m*, and the contact's parameters (k_n, k_s, k_r, ξ).
+typedef struct dem_network_contact {
+    size_t i, j;
+    dem_vec3 n;
+    double ai, aj, rstar, mstar;
+    const dem_contact_params *p;
+} dem_network_contact;
+
+/// A contact network: the granules' masses and moments of inertia, and the
+/// contacts between them. Its limit depends on the order of the contacts in
+/// its last bits (the power iteration sums them in that order).
+typedef struct dem_contact_network {
+    size_t granules;
+    const double *mass, *inertia;
+    size_t count;
+    const dem_network_contact *contact;
+} dem_contact_network;
+
+/// How the network is integrated: the limit differs.
+typedef struct dem_integration {
+    int implicit_damping;  ///< dem_world_def.implicit_damping
+    int implicit_springs;  ///< as decided (never auto)
+    int dashpot_switches;  ///< some dashpot is switched on and off within a contact
+} dem_integration;
+
+/// Limit of a network: a pure function of it.
+dem_stability dem_stability_of_network(const dem_contact_network *net, const dem_integration *how, double dt_crit);
+
+/// Limit of the densest cluster of equal granules of mass m_min and radius
+/// r_min (face-centred cubic, 12 contacts each, the most an equal sphere can
+/// have) with contact parameters p, all springs sticking; lever_factor 1 for
+/// the contact-point lever arm, 0 for R.
+dem_stability dem_stability_fcc(const dem_contact_params *p, double lever_factor, const dem_integration *how,
+                                double m_min, double r_min, double dt_crit);
+
+/// Limit for the scene before it runs: dem_stability_fcc of the scene's
+/// lightest granules, with the stiffest of the granule and wall springs.
+/// Conservative: heavier neighbours only lower the frequencies.
 dem_stability dem_stability_apriori(const dem_world *w);
 
 /// Limit of the world's current contact network (e.g. a settled bed).
 dem_stability dem_stability_current(dem_world *w);
-
-/// Limit for the contacts of any world, used by both of the above.
-dem_stability dem_stability_of_network(dem_world *w, double dt_crit);
 
 #endif

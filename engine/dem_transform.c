@@ -6,7 +6,7 @@
 // keeps its overlap, its spring and hence its force, only turned.
 #include <math.h>
 
-#include "dem_world_internal.h"
+#include "dem_state_internal.h"
 
 typedef struct rotation {
     dem_vec3 k; // unit axis

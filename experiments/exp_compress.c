@@ -18,7 +18,7 @@
 // the solver"; only a spin can be set). The piston is moved here by writing
 // its plane point between steps, which is all the engine reads of a plane.
 // See move_piston: the one place that touches the engine's private layout.
-#include "dem_world_internal.h"
+#include "dem_state_internal.h"
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_pour.h"

@@ -949,7 +949,7 @@ static void test_momentum_conserved(void **state)
 // The engine gathers per-pair forces in a fixed order, so runs must be bitwise
 // identical: twice with the same settings, and with 1 and 2 threads. The bed
 // has 640 granules, above the engine's threshold for starting OpenMP threads
-// (DEM_OMP_MIN_GRANULES = 512 in dem_world_internal.h), so the 2-thread runs
+// (DEM_OMP_MIN_GRANULES = 512 in dem_threads_internal.h), so the 2-thread runs
 // really split the loops.
 static dem_world *small_bed(int threads)
 {

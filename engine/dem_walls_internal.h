@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+// Walls as the engine keeps them: the definition, the contact law's
+// coefficients, each granule's springs against the wall, and the granules
+// near enough to touch it before the next list rebuild.
+#ifndef DEM_WALLS_INTERNAL_H
+#define DEM_WALLS_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dem_contact.h"
+#include "dem_world.h" // dem_wall_def
+
+#define DEM_MAX_WALLS 8
+
+typedef struct dem_wall {
+    dem_wall_def def;
+    char name[32];
+    dem_contact_coeffs coeffs;
+    unsigned features;
+    int hist_len;
+    double *hist; // hist_len doubles per granule
+    // Granules within one skin of this wall at the last list rebuild, in
+    // ascending order: the only ones that can touch it before the next (the
+    // solver never moves a wall, and no granule moves half a skin between
+    // rebuilds).
+    uint32_t *near;
+    size_t near_count, near_cap;
+} dem_wall;
+
+// Geometry of a granule against a wall: overlap, unit normal from the granule
+// towards the wall, and the contact point on the wall surface.
+typedef struct dem_wall_touch {
+    double overlap;
+    dem_vec3 normal, point;
+} dem_wall_touch;
+
+static inline dem_wall_touch dem_wall_geometry(const dem_wall_def *wd, dem_vec3 p, double r)
+{
+    dem_wall_touch t = {-1.0, {0, 0, 0}, {0, 0, 0}};
+    if (wd->kind == DEM_WALL_CYLINDER) {
+        dem_vec3 d = dem_v3_sub(p, wd->point);
+        dem_vec3 radial = dem_v3_axpy(-dem_v3_dot(d, wd->axis), wd->axis, d);
+        double rho = dem_v3_norm(radial);
+        if (rho <= 0.0) return t;
+        t.normal = dem_v3_scale(radial, 1.0 / rho);
+        t.overlap = r + rho - wd->radius;
+        t.point = dem_v3_axpy(wd->radius - rho, t.normal, p);
+        return t;
+    }
+    double dist = dem_v3_dot(dem_v3_sub(p, wd->point), wd->normal);
+    t.normal = dem_v3_neg(wd->normal);
+    t.overlap = r - dist;
+    t.point = dem_v3_axpy(-dist, wd->normal, p);
+    if (wd->kind == DEM_WALL_DISC && dem_v3_norm(dem_v3_sub(t.point, wd->point)) > wd->radius) t.overlap = -1.0;
+    return t;
+}
+
+// The wall's near list for granules at pos with radii rad (n of them), and a
+// skin: a granule is near if a sphere one skin larger would touch the wall.
+// The springs of the others are cleared. 0, or 1 out of memory.
+int dem_wall_near_rebuild(dem_wall *wall, size_t n, const dem_vec3 *pos, const double *rad, double skin);
+
+#endif
