@@ -7,9 +7,14 @@
 
 #include <stddef.h>
 
+#include <omp.h>
+
 // Below this many granules a step is a few microseconds of work and starting
 // OpenMP threads would cost more than it saves.
 #define DEM_OMP_MIN_GRANULES 512
+
+// Whether loops over n granules run on several threads.
+static inline int dem_threads_split(size_t n) { return n >= DEM_OMP_MIN_GRANULES && omp_get_max_threads() > 1; }
 
 // Granules [lo, hi) of thread t of nt.
 static inline void dem_thread_block(size_t n, int t, int nt, size_t *lo, size_t *hi)
