@@ -133,7 +133,7 @@ int dem_contact_params_check(const dem_contact_params *p, char *msg, unsigned lo
 /// neither creates nor destroys spring length.
 static DEM_ALWAYS_INLINE dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, double twist)
 {
-    // Branch-free, so that a batch of contacts vectorises (dem_forces.c): a
+    // Branch-free, so that a batch of contacts vectorises (dem_contact_batch_internal.h): a
     // zero spring, or one turned onto n, projects to zero and keeps scale 0;
     // the guard only keeps the unused quotient finite.
     double len2 = dem_v3_norm2(spring);
@@ -146,7 +146,7 @@ static DEM_ALWAYS_INLINE dem_vec3 dem_spring_carry(dem_vec3 spring, dem_vec3 n, 
 
 /// The law in stages, each a function of the last one's results, so that a
 /// batch of contacts can run each stage over the whole batch in turn
-/// (dem_forces.c): a stage's chain of dependent square roots and divisions
+/// (dem_contact_batch_internal.h): a stage's chain of dependent square roots and divisions
 /// is then short, and the processor overlaps it across contacts, where the
 /// whole law in one loop left it waiting on each chain in turn.
 /// dem_contact_eval runs the same stages one after the other: one

@@ -11,7 +11,7 @@
 #include "dem_threads_internal.h"
 #include "dem_wall_contacts_internal.h"
 
-int dem_forces_threaded(const dem_world *w) { return dem_threads_split(w->n); }
+int dem_forces_threaded(const dem_world *w) { return dem_threads_split(w->n, dem_world_team(w)); }
 
 int dem_forces_blockwise(const dem_world *w)
 {

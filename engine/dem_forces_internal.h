@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Forces and torques of a world's current state: the granule–granule pair
-// loops and the granule–wall contacts (dem_forces.c).
+// loops (dem_pairs.c) and the granule–wall contacts (dem_wall_contacts.c).
 #ifndef DEM_FORCES_INTERNAL_H
 #define DEM_FORCES_INTERNAL_H
 

@@ -84,7 +84,7 @@ static void imp_pair_apply(dem_world *restrict w, const double *restrict x)
 {
     const size_t n = w->n;
     const double cc = 0.25 * w->dt * w->dt, dt = w->dt;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t i = 0; i < n; ++i)
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) {
             const dem_imp_contact *c = &w->imp->pair[k];
@@ -119,7 +119,7 @@ static void imp_apply(dem_world *restrict w, const double *restrict x, double *r
 {
     imp_pair_apply(w, x);
     const size_t n = w->n;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t i = 0; i < n; ++i) {
         const double *xi = x + 6 * i;
         double *yi = y + 6 * i, m = w->mass[i], in = w->inertia[i];
@@ -177,7 +177,7 @@ static int imp_blocks_and_rhs(dem_world *restrict w)
     const size_t n = w->n;
     const dem_vec3 g = w->def.gravity;
     int any = 0;
-#pragma omp parallel for schedule(static) reduction(|| : any) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) reduction(|| : any) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t i = 0; i < n; ++i) {
         double *b = w->imp->chol + 36 * i, *rhs = w->imp->b + 6 * i;
         memcpy(b, w->imp->wall + 36 * i, 36 * sizeof *b);
@@ -205,7 +205,7 @@ static int imp_blocks_and_rhs(dem_world *restrict w)
 static double imp_dot(dem_world *restrict w, const double *a, const double *b)
 {
     const size_t n = w->n, chunks = (n + DEM_IMP_CHUNK - 1) / DEM_IMP_CHUNK;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t c = 0; c < chunks; ++c) {
         size_t end = (c + 1) * DEM_IMP_CHUNK < n ? (c + 1) * DEM_IMP_CHUNK : n;
         double s = 0;
@@ -220,7 +220,7 @@ static double imp_dot(dem_world *restrict w, const double *a, const double *b)
 static void imp_precondition(dem_world *restrict w, const double *r, double *z)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t i = 0; i < n; ++i) chol6_solve(w->imp->chol + 36 * i, r + 6 * i, z + 6 * i);
 }
 
@@ -229,7 +229,7 @@ static void imp_update(dem_world *restrict w, double alpha, double *y)
 {
     const size_t len = 6 * w->n;
     dem_implicit *s = w->imp;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t k = 0; k < len; ++k) y[k] += alpha * s->p[k], s->r[k] -= alpha * s->q[k];
     imp_precondition(w, s->r, s->z);
 }

@@ -75,7 +75,7 @@ int dem_lists_rebuild(dem_world *w)
     swap_lists(w);
     const dem_nl_granules g = {n, w->pos, w->rad, w->inv_mass};
     const dem_domain dom = dem_world_domain(w);
-    const int nl = dem_nl_rebuild(&w->nl, &w->nl_old, old_rows, &g, &dom, w->skin);
+    const int nl = dem_nl_rebuild(&w->nl, &w->nl_old, old_rows, &g, &dom, w->skin, dem_world_team(w));
     if (nl == DEM_NL_NOMEM_GRID) return dem_world_set_error(w, "out of memory building the cell grid");
     if (nl != DEM_NL_OK || ensure_pair_scratch(w) || dem_nl_reverse(&w->nl, n, &w->rev_start, w->rev_pair) ||
         build_wall_lists(w))
@@ -90,7 +90,8 @@ int dem_lists_refresh(dem_world *w)
 {
     const double half_skin = 0.5 * w->skin;
     const dem_domain dom = dem_world_domain(w);
-    if (w->list_valid && dem_nl_max_displacement2(&dom, w->pos, w->pos_at_build, w->n) <= half_skin * half_skin)
+    if (w->list_valid &&
+        dem_nl_max_displacement2(&dom, w->pos, w->pos_at_build, w->n, dem_world_team(w)) <= half_skin * half_skin)
         return 0;
     return dem_lists_rebuild(w); // also the walls' near lists (a wall added since unprepares the world)
 }

@@ -210,7 +210,7 @@ static double max_radius(const dem_nl_granules *g)
 }
 
 int dem_nl_rebuild(dem_neighbor_list *nl, const dem_neighbor_list *old, size_t old_rows, const dem_nl_granules *gr,
-                   const dem_domain *dom, double skin)
+                   const dem_domain *dom, double skin, int threads)
 {
     const size_t n = gr->n;
     size_t *start = realloc(nl->start, (n + 1) * sizeof *start);
@@ -226,13 +226,13 @@ int dem_nl_rebuild(dem_neighbor_list *nl, const dem_neighbor_list *old, size_t o
         return DEM_NL_NOMEM_GRID;
     }
     start[0] = 0;
-#pragma omp parallel for schedule(static) if (n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (n >= DEM_OMP_MIN_GRANULES) num_threads(threads)
     for (size_t i = 0; i < n; ++i) start[i + 1] = scan_row(gr, dom, skin, &g, i, NULL);
     for (size_t i = 0; i < n; ++i) start[i + 1] += start[i];
     nl->count = start[n];
     int fail = ensure_pairs(nl, nl->count);
     if (!fail) {
-#pragma omp parallel for schedule(static) if (n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (n >= DEM_OMP_MIN_GRANULES) num_threads(threads)
         for (size_t i = 0; i < n; ++i) {
             scan_row(gr, dom, skin, &g, i, nl->j + start[i]);
             sort_row(nl->j + start[i], start[i + 1] - start[i]);
@@ -259,10 +259,11 @@ double dem_nl_max_displacement2_range(const dem_domain *dom, const dem_vec3 *pos
     return m;
 }
 
-double dem_nl_max_displacement2(const dem_domain *dom, const dem_vec3 *pos, const dem_vec3 *pos_at_build, size_t n)
+double dem_nl_max_displacement2(const dem_domain *dom, const dem_vec3 *pos, const dem_vec3 *pos_at_build, size_t n,
+                                int threads)
 {
     double m = 0;
-#pragma omp parallel reduction(max : m) if (n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel reduction(max : m) if (n >= DEM_OMP_MIN_GRANULES) num_threads(threads)
     {
         size_t lo, hi;
         dem_thread_block(n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);

@@ -45,21 +45,22 @@ typedef struct dem_nl_granules {
 enum { DEM_NL_OK = 0, DEM_NL_NOMEM = 1, DEM_NL_NOMEM_GRID = 2 };
 
 // Rebuild `nl` (its hist_len set by the caller) for granules g in domain dom
-// with the given skin, carrying each surviving pair's history from `old`
+// with the given skin, on a team of `threads`, carrying each surviving pair's history from `old`
 // (built for old_rows granules; 0: nothing to carry). Its capacity grows as
 // needed (nl->cap pairs). DEM_NL_OK or a DEM_NL_NOMEM*.
 int dem_nl_rebuild(dem_neighbor_list *nl, const dem_neighbor_list *old, size_t old_rows, const dem_nl_granules *g,
-                   const dem_domain *dom, double skin);
+                   const dem_domain *dom, double skin, int threads);
 // The reverse index of the list over n granules: for each granule, the pairs
 // in which it is j, ascending (rev_start: n + 1 offsets, reallocated;
 // rev_pair: nl->count entries, of the caller's). 0, or 1 out of memory.
 int dem_nl_reverse(const dem_neighbor_list *nl, size_t n, size_t **rev_start, size_t *rev_pair);
 // The largest squared displacement of pos from pos_at_build over granules
 // [lo, hi) (minimum image), for a caller already on a thread; and over all n
-// on the threads.
+// on a team of `threads`.
 double dem_nl_max_displacement2_range(const dem_domain *dom, const dem_vec3 *pos, const dem_vec3 *pos_at_build,
                                       size_t lo, size_t hi);
-double dem_nl_max_displacement2(const dem_domain *dom, const dem_vec3 *pos, const dem_vec3 *pos_at_build, size_t n);
+double dem_nl_max_displacement2(const dem_domain *dom, const dem_vec3 *pos, const dem_vec3 *pos_at_build, size_t n,
+                                int threads);
 // A deep copy of src into dst (*fail set on out of memory).
 void dem_nl_clone(dem_neighbor_list *dst, const dem_neighbor_list *src, int *fail);
 void dem_nl_free(dem_neighbor_list *nl);

@@ -426,7 +426,7 @@ static DEM_ALWAYS_INLINE void block_own_pairs(dem_world *restrict w, size_t lo, 
 
 static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const unsigned mask)
 {
-#pragma omp parallel
+#pragma omp parallel num_threads(dem_world_team(w))
     {
         size_t lo, hi;
         dem_thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
@@ -438,7 +438,7 @@ static DEM_ALWAYS_INLINE void pair_loop_threaded(dem_world *restrict w, const un
 
 static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned mask)
 {
-    if (dem_threads_split(w->n)) pair_loop_threaded(w, mask);
+    if (dem_threads_split(w->n, dem_world_team(w))) pair_loop_threaded(w, mask);
     else pair_loop_serial(w, mask);
 }
 
@@ -489,7 +489,7 @@ static const pair_loop_fn general_image_pair_loops[8] = DEM_BY_MASK_8(general_im
 static void gather_damping(dem_world *restrict w)
 {
     const size_t n = w->n;
-#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel for schedule(static) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     for (size_t i = 0; i < n; ++i) {
         double d[6] = {0, 0, 0, 0, 0, 0};
         for (size_t k = w->nl.start[i]; k < w->nl.start[i + 1]; ++k) add_damping(d, w->pair_g[k], w->pair_n[k]);

@@ -9,6 +9,7 @@
 #define DEM_STATE_INTERNAL_H
 
 #include <float.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 
@@ -66,6 +67,8 @@ struct dem_world {
     int list_valid;
     uint64_t rebuilds;
 
+    int threads; // of its parallel regions (dem_world_def.threads, dem_world_set_threads); 0: OpenMP's default
+
     double time, dt, dt_limit, lever_factor;
     double hist_dt; // dt when positions moved since the last force evaluation, else 0
     int moved;
@@ -74,6 +77,10 @@ struct dem_world {
     char err[512];
     char dt_report[512];
 };
+
+// The team size of this world's parallel regions: its own thread count, or
+// OpenMP's default for 0.
+static inline int dem_world_team(const dem_world *w) { return w->threads > 0 ? w->threads : omp_get_max_threads(); }
 
 static inline dem_domain dem_world_domain(const dem_world *w)
 {

@@ -261,7 +261,7 @@ KICK_PASS(kick_range, kick_one)
 static size_t on_threads(dem_world *w, size_t (*range)(const dem_world *, size_t, size_t))
 {
     size_t first_bad = SIZE_MAX;
-#pragma omp parallel reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel reduction(min : first_bad) if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     {
         size_t lo, hi;
         dem_thread_block(w->n, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);
@@ -433,11 +433,12 @@ static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, ui
 static team_result step_team(dem_world *w, uint64_t steps)
 {
     team_result r = {0, TEAM_DONE, SIZE_MAX};
-    team_slot *slot = aligned_alloc(64, (size_t)omp_get_max_threads() * sizeof *slot);
+    const int team = dem_world_team(w);
+    team_slot *slot = aligned_alloc(64, (size_t)team * sizeof *slot);
     uint32_t *rows = malloc(w->n * sizeof *rows);
     if (slot && rows) {
         w->hist_dt = w->dt;
-#pragma omp parallel
+#pragma omp parallel num_threads(team)
         {
             const team_result mine = team_thread(w, slot, rows, steps);
             if (omp_get_thread_num() == 0) r = mine; // every thread's is the same

@@ -152,7 +152,7 @@ static DEM_ALWAYS_INLINE void wall_contacts(dem_world *restrict w, const dem_wal
 // Only the granules near the wall (dem_wall.near): the others are out of reach.
 static DEM_ALWAYS_INLINE void wall_loop(dem_world *restrict w, const dem_wall *wall, const unsigned mask)
 {
-#pragma omp parallel if (w->n >= DEM_OMP_MIN_GRANULES)
+#pragma omp parallel if (w->n >= DEM_OMP_MIN_GRANULES) num_threads(dem_world_team(w))
     {
         size_t lo, hi;
         dem_thread_block(wall->near_count, omp_get_thread_num(), omp_get_num_threads(), &lo, &hi);

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The world: its lifetime (create, clone, destroy), its granules and walls,
 // and its accessors. Stepping is dem_step.c's.
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,9 +69,9 @@ dem_world *dem_world_create(const dem_world_def *def, char *err, size_t err_len)
     // Provisional until dem_world_prepare decides "auto" (dem_stability_current
     // may be asked before).
     w->implicit_springs = def->implicit_springs == DEM_IMPLICIT_AUTO ? 0 : def->implicit_springs != 0;
+    w->threads = def->threads > 0 ? def->threads : 0; // OpenMP's process-wide count is the caller's
     w->lever_factor = def->lever_arm == DEM_LEVER_RADIUS ? 0.0 : 1.0;
     refresh_features(w);
-    if (def->threads > 0) omp_set_num_threads(def->threads);
     return w;
 }
 
@@ -325,6 +324,14 @@ double dem_world_time(const dem_world *w) { return w->time; }
 double dem_world_dt(const dem_world *w) { return w->dt; }
 double dem_world_dt_limit(const dem_world *w) { return w->dt_limit; }
 int dem_world_implicit_springs(const dem_world *w) { return w->implicit_springs; }
+int dem_world_threads(const dem_world *w) { return dem_world_team(w); }
+
+dem_status dem_world_set_threads(dem_world *w, int threads)
+{
+    if (threads < 0) return dem_world_set_error(w, "threads = %d: must be >= 0", threads), DEM_ERR_INVALID;
+    w->threads = threads;
+    return DEM_OK;
+}
 double dem_world_implicit_iterations(const dem_world *w)
 {
     return w->imp_stats.solves ? (double)w->imp_stats.iterations / (double)w->imp_stats.solves : 0.0;

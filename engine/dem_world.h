@@ -66,9 +66,12 @@ typedef struct dem_world_def {
     double dt_safety;               ///< fraction of the stability limit used when choosing, default 0.9
     dem_vec3 domain_lo, domain_hi;  ///< granules outside are reported escaped
     int periodic_axis;              ///< −1 none, else 0/1/2: periodic between domain_lo and domain_hi
-    double skin;                    ///< Verlet skin, m; 0 = 0.2 × smallest radius... see dem_world.c
+    double skin;                    ///< Verlet skin, m; 0 = 0.4 × the smallest radius (dem_world_prepare)
     dem_lever_arm lever_arm;
-    int threads;                    ///< OpenMP threads; 0 = OpenMP's default
+    /// OpenMP threads of this world's parallel regions; 0 = OpenMP's default
+    /// (omp_get_max_threads() when a region starts). OpenMP's process-wide
+    /// setting is never changed.
+    int threads;
     /// Integrate the normal dashpots semi-implicitly: each granule's velocity
     /// update sees its own dashpots at the new velocity (backward Euler in
     /// its own velocity, neighbours explicit), i.e. it is divided by the
@@ -216,6 +219,12 @@ double dem_world_dt(const dem_world *w);
 double dem_world_dt_limit(const dem_world *w);
 /// Whether the world steps with implicit springs (decided by dem_world_prepare).
 int dem_world_implicit_springs(const dem_world *w);
+/// OpenMP threads the world's steps run on (dem_world_def.threads, or
+/// OpenMP's default now).
+int dem_world_threads(const dem_world *w);
+/// Change the world's thread count (0: OpenMP's default); results are
+/// bitwise the same for any count. DEM_ERR_INVALID for a negative count.
+dem_status dem_world_set_threads(dem_world *w, int threads);
 /// Mean conjugate-gradient iterations per step of the implicit spring solve.
 double dem_world_implicit_iterations(const dem_world *w);
 unsigned dem_world_features(const dem_world *w);

@@ -221,7 +221,7 @@ static dem_world *stepped_on(const dem_world *bed, int threads, uint64_t steps)
 {
     dem_world *w = dem_world_clone(bed);
     assert_non_null(w);
-    omp_set_num_threads(threads);
+    assert_int_equal(dem_world_set_threads(w, threads), DEM_OK);
     assert_int_equal(dem_world_step(w, steps), DEM_OK);
     return w;
 }
@@ -447,6 +447,25 @@ static void test_refused_rotation_changes_nothing(void **state)
     dem_world_destroy(w), dem_world_destroy(copy), dem_world_destroy(slab);
 }
 
+// A world's thread count is its own: creating one leaves OpenMP's
+// process-wide setting alone (a caller running worlds side by side, as the
+// calibration does, keeps its own), and it can be changed for one world.
+static void test_world_threads_are_its_own(void **state)
+{
+    (void)state;
+    const int before = omp_get_max_threads();
+    dem_world_def def = dem_default_world_def();
+    def.threads = before + 2;
+    dem_world *w = dem_world_create(&def, NULL, 0);
+    assert_non_null(w);
+    assert_int_equal(omp_get_max_threads(), before);
+    assert_int_equal(dem_world_threads(w), before + 2);
+    assert_int_equal(dem_world_set_threads(w, 0), DEM_OK);
+    assert_int_equal(dem_world_threads(w), before);
+    assert_int_equal(dem_world_set_threads(w, -1), DEM_ERR_INVALID);
+    dem_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -458,6 +477,7 @@ int main(void)
         cmocka_unit_test(test_tangential_to_rolling_restarts_springs),
         cmocka_unit_test(test_rotation_turns_the_springs_with_the_bed),
         cmocka_unit_test(test_refused_rotation_changes_nothing),
+        cmocka_unit_test(test_world_threads_are_its_own),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

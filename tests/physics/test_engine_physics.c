@@ -875,7 +875,7 @@ static void momentum_run(int implicit_springs)
     const double R = 1e-4;
     dem_world_def def = dem_default_world_def(); // Table 3: damping, friction, rolling all on
     // Both integrations: the implicit springs' solve stops at a tolerance and
-    // restores the momenta of an isolated world (dem_forces.c).
+    // restores the momenta of an isolated world (dem_implicit.c).
     def.implicit_springs = implicit_springs;
     def.gravity = dem_v3(0, 0, 0);
     def.threads = 2;
@@ -993,7 +993,7 @@ static void test_determinism(void **state)
     dem_diagnostics d = {0};
     for (int r = 0; r < 3; ++r) {
         dem_world *w = small_bed(threads[r]);
-        int got_threads = omp_get_max_threads();
+        int got_threads = dem_world_threads(w);
         step_ok(w, STEPS);
         dem_granules_view g = dem_world_granules(w);
         n = g.count;
@@ -1004,7 +1004,7 @@ static void test_determinism(void **state)
             assert_non_null(snap[r][a]);
             memcpy(snap[r][a], src[a], n * sizeof(dem_vec3));
         }
-        printf("  run %d: %d thread(s) (OpenMP reports %d), %zu granules, %d steps, t = %.4g s, %zu contacts, "
+        printf("  run %d: %d thread(s) (the world reports %d), %zu granules, %d steps, t = %.4g s, %zu contacts, "
                "%zu wall contacts\n",
                r + 1, threads[r], got_threads, n, STEPS, dem_world_time(w), d.contacts, d.wall_contacts);
         assert_int_equal(got_threads, threads[r]);

@@ -460,7 +460,7 @@ static void test_coincident_centres(void **state)
     const dem_vec3 p[] = {dem_v3(0.001, 0.01, 0.002), dem_v3(0.001, 0.01, 0.002)};
     const double equal[] = {0.5 * D50, 0.5 * D50}, extreme[] = {rmax, rmin}, extreme_rev[] = {rmin, rmax};
     // The normal of a pair is undefined at zero separation; the engine must
-    // pick one (dem_forces.c: safe_normal) and push the pair apart.
+    // pick one (dem_pair_contact_internal.h: safe_normal) and push the pair apart.
     degenerate_case("coincident centres, equal radii", 0, 2, p, equal);
     degenerate_case("coincident centres, d_max then d_min", 0, 2, p, extreme);
     degenerate_case("coincident centres, d_min then d_max", 0, 2, p, extreme_rev);
@@ -684,7 +684,7 @@ static dem_world *determinism_run(const dem_world *bed, int threads, uint64_t st
 {
     dem_world *w = dem_world_clone(bed);
     assert_non_null(w);
-    omp_set_num_threads(threads);
+    assert_int_equal(dem_world_set_threads(w, threads), DEM_OK);
     double t0 = omp_get_wtime();
     step_ok(w, steps, "determinism run");
     *wall_s = omp_get_wtime() - t0;
@@ -715,7 +715,7 @@ static dem_status fault_on_threads(const dem_world *bed, int threads, void (*inj
 {
     dem_world *w = dem_world_clone(bed);
     assert_non_null(w);
-    omp_set_num_threads(threads);
+    assert_int_equal(dem_world_set_threads(w, threads), DEM_OK);
     inject(w);
     const dem_status st = dem_world_step(w, 5000);
     snprintf(msg, len, "%s", dem_world_error(w));
@@ -739,7 +739,7 @@ static void spin_free_granule(dem_world *w)
     assert_true(dem_world_add_granule(w, dem_v3(0, 0.15, 0), zero, huge, 0.5 * D50, RHO) >= 0);
 }
 
-// With 2 threads the steps run in one parallel region (dem_world.c, "the step
+// With 2 threads the steps run in one parallel region (dem_step.c, "the step
 // team"), which stops after the drift when a granule escaped and after the
 // kick when a state is not finite: the same fault, granule, step and state as
 // on one thread.
@@ -785,7 +785,7 @@ static void test_determinism_and_threads(void **state)
     // 1 against 2 threads from the same settled bed. Few steps: on a loaded
     // machine libgomp's barriers cost milliseconds each (docs/calibration.md, "OpenMP on a shared machine"), and any
     // thread-dependent rounding shows in the last bits at once. The tolerance
-    // is zero, bitwise, because the engine promises it (dem_forces.c: per-pair
+    // is zero, bitwise, because the engine promises it (dem_pairs.c: per-pair
     // slots gathered in a fixed order, no floating-point reduction across
     // threads).
     const uint64_t steps = 200;
