@@ -80,7 +80,7 @@ static void zero_pointers(dem_world *s)
 {
     s->pos = s->vel = s->omg = s->frc = s->trq = s->pos_at_build = NULL;
     s->rad = s->mass = s->inertia = s->inv_mass = s->inv_inertia = s->damp = s->acc = NULL;
-    s->id = NULL;
+    s->id = NULL, s->fixed = NULL;
     s->pair_f = s->pair_ti = s->pair_tj = s->pair_n = NULL, s->pair_g = NULL;
     s->rev_start = s->rev_pair = NULL;
     memset(&s->nl_old, 0, sizeof s->nl_old);
@@ -103,6 +103,7 @@ static void put_world(ck_file *c, const dem_world *w)
     put_doubles(c, "inv_mass", n, w->inv_mass), put_doubles(c, "inv_inertia", n, w->inv_inertia);
     put_doubles(c, "damp", 6 * n, w->damp), put_doubles(c, "acc", 6 * n, w->acc);
     put(c, "id", H5T_NATIVE_UINT64, n, w->id);
+    put(c, "fixed", H5T_NATIVE_UCHAR, n, w->fixed);
     put_doubles(c, "pair_f", 3 * pairs, w->pair_f), put_doubles(c, "pair_ti", 3 * pairs, w->pair_ti);
     put_doubles(c, "pair_tj", 3 * pairs, w->pair_tj), put_doubles(c, "pair_n", 3 * pairs, w->pair_n);
     put_doubles(c, "pair_g", pairs, w->pair_g);
@@ -226,6 +227,7 @@ static void get_arrays(ck_file *c, dem_world *w)
     w->inv_inertia = get_new(c, "inv_inertia", D, n, cap, sizeof(double));
     w->damp = get_new(c, "damp", D, n, cap, 6 * sizeof(double)), w->acc = get_new(c, "acc", D, n, cap, 6 * sizeof(double));
     w->id = get_new(c, "id", H5T_NATIVE_UINT64, n, cap, sizeof(uint64_t));
+    w->fixed = get_new(c, "fixed", H5T_NATIVE_UCHAR, n, cap, 1);
     w->pair_f = get_new(c, "pair_f", D, pairs, pcap, sizeof(dem_vec3));
     w->pair_ti = get_new(c, "pair_ti", D, pairs, pcap, sizeof(dem_vec3));
     w->pair_tj = get_new(c, "pair_tj", D, pairs, pcap, sizeof(dem_vec3));

@@ -86,11 +86,19 @@ int dem_lists_rebuild(dem_world *w)
     return 0;
 }
 
+int dem_lists_walls_moved(const dem_world *w)
+{
+    const double half_skin = 0.5 * w->skin;
+    for (int k = 0; k < w->n_walls; ++k)
+        if (dem_wall_travel2(&w->walls[k]) > half_skin * half_skin) return 1;
+    return 0;
+}
+
 int dem_lists_refresh(dem_world *w)
 {
     const double half_skin = 0.5 * w->skin;
     const dem_domain dom = dem_world_domain(w);
-    if (w->list_valid &&
+    if (w->list_valid && !dem_lists_walls_moved(w) &&
         dem_nl_max_displacement2(&dom, w->pos, w->pos_at_build, w->n, dem_world_team(w)) <= half_skin * half_skin)
         return 0;
     return dem_lists_rebuild(w); // also the walls' near lists (a wall added since unprepares the world)

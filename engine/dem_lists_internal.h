@@ -10,9 +10,11 @@
 
 // Rebuild every list now; 0, or 1 out of memory (message set).
 int dem_lists_rebuild(dem_world *w);
-// Rebuild if the lists are not valid or a granule moved more than half the
-// skin since they were built; 0, or 1 out of memory.
+// Rebuild if the lists are not valid or a granule or a wall moved more than
+// half the skin since they were built; 0, or 1 out of memory.
 int dem_lists_refresh(dem_world *w);
+// Whether a wall has moved more than half the skin since the last rebuild.
+int dem_lists_walls_moved(const dem_world *w);
 
 // The largest squared displacement since the last rebuild over granules
 // [lo, hi), for a caller already on a thread.

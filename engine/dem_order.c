@@ -59,6 +59,7 @@ static void permute_granules(dem_world *w, const uint32_t *perm, unsigned char *
     for (size_t k = 0; k < sizeof vec / sizeof *vec; ++k) permute(vec[k], v3, perm, n, tmp);
     for (size_t k = 0; k < sizeof scalar / sizeof *scalar; ++k) permute(scalar[k], d, perm, n, tmp);
     permute(w->id, sizeof *w->id, perm, n, tmp);
+    permute(w->fixed, sizeof *w->fixed, perm, n, tmp);
     permute(w->acc, 6 * d, perm, n, tmp);
     permute(w->damp, 6 * d, perm, n, tmp);
     for (int k = 0; k < w->n_walls; ++k)

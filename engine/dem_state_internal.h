@@ -36,6 +36,11 @@ struct dem_world {
     double *rad, *mass, *inertia, *inv_mass, *inv_inertia;
     uint64_t *id;
     uint64_t next_id;
+    // Fixed granules (dem_world_set_granule_fixed): 1 where held still; the
+    // kicks and the drift pass over them. Their mass stays theirs in every
+    // contact (LIGGGHTS' fix freeze does the same).
+    unsigned char *fixed;
+    size_t n_fixed;
 
     // Walls: never moved by the solver.
     int n_walls;

@@ -64,7 +64,7 @@ static void decide_integration(dem_world *w)
         return;
     }
     w->implicit_springs = 0;
-    if (w->def.implicit_damping || !(w->def.dt > 0)) return;
+    if (w->def.implicit_damping || !(w->def.dt > 0) || w->n_fixed) return;
     w->implicit_springs = w->def.dt > dem_stability_apriori(w).dt_limit;
 }
 
@@ -82,6 +82,11 @@ dem_status dem_world_prepare(dem_world *w)
         return DEM_OK;
     }
     decide_integration(w);
+    if (w->implicit_springs && w->n_fixed) {
+        dem_world_set_error(w, "fixed granules need the explicit integration or the implicit dashpot, not implicit "
+                               "springs (the network solve would move them)");
+        return DEM_ERR_INVALID;
+    }
     dem_stability st = dem_stability_apriori(w);
     dem_status status = apply_limit(w, &st, "a priori");
     if (status != DEM_OK) return status;
@@ -135,6 +140,7 @@ typedef struct kick_ctx {
     dem_vec3 *vel, *omg, *pos;
     const dem_vec3 *frc, *trq;
     const double *inv_mass, *inv_inertia, *mass, *acc, *damp;
+    const unsigned char *fixed; // per granule: held still (read only where the world has fixed granules)
     dem_vec3 gravity, lo, hi;
     double half_dt, dt;
     double wrap_lo, wrap_len; // the periodic axis' lower end and length
@@ -150,7 +156,7 @@ static kick_ctx kick_ctx_make(const dem_world *w)
                            : w->def.implicit_damping ? KICK_IMPLICIT_DAMPING
                                                      : KICK_EXPLICIT;
     return (kick_ctx){w->vel, w->omg, w->pos, w->frc, w->trq, w->inv_mass, w->inv_inertia, w->mass, w->acc,
-                      w->damp, w->def.gravity, w->def.domain_lo, w->def.domain_hi, 0.5 * w->dt, w->dt, wrap_lo,
+                      w->damp, w->fixed, w->def.gravity, w->def.domain_lo, w->def.domain_hi, 0.5 * w->dt, w->dt, wrap_lo,
                       a >= 0 ? dem_v3_comp(w->def.domain_hi, a) - wrap_lo : 0.0, a, mode};
 }
 
@@ -234,23 +240,31 @@ static DEM_ALWAYS_INLINE int kick_one(const kick_ctx *restrict c, size_t i, cons
 }
 
 // The first granule of [lo, hi) for which f(c, i, mode) fails, or SIZE_MAX;
-// one loop per mode, so that each is free of the others' branches.
+// one loop per mode, so that each is free of the others' branches, and the
+// loops that pass over fixed granules (dem_world_set_granule_fixed) apart
+// from those of a world without any.
 #define KICK_PASS(name, f)                                                                            \
     static DEM_ALWAYS_INLINE size_t name##_mode(const kick_ctx *restrict c, size_t lo, size_t hi,      \
-                                                const kick_mode mode)                                 \
+                                                const kick_mode mode, const int with_fixed)           \
     {                                                                                                 \
         size_t first_bad = SIZE_MAX;                                                                  \
         for (size_t i = lo; i < hi; ++i)                                                              \
-            if (!f(c, i, mode) && i < first_bad) first_bad = i;                                       \
+            if (!(with_fixed && c->fixed[i]) && !f(c, i, mode) && i < first_bad) first_bad = i;       \
         return first_bad;                                                                             \
+    }                                                                                                 \
+    static size_t name##_fixed(const kick_ctx *c, size_t lo, size_t hi)                               \
+    {                                                                                                 \
+        if (c->mode == KICK_EXPLICIT) return name##_mode(c, lo, hi, KICK_EXPLICIT, 1);                \
+        return name##_mode(c, lo, hi, KICK_IMPLICIT_DAMPING, 1);                                      \
     }                                                                                                 \
     static size_t name(const dem_world *w, size_t lo, size_t hi)                                      \
     {                                                                                                 \
         const kick_ctx c = kick_ctx_make(w);                                                          \
+        if (w->n_fixed) return name##_fixed(&c, lo, hi);                                              \
         switch (c.mode) {                                                                             \
-        case KICK_EXPLICIT: return name##_mode(&c, lo, hi, KICK_EXPLICIT);                            \
-        case KICK_IMPLICIT_DAMPING: return name##_mode(&c, lo, hi, KICK_IMPLICIT_DAMPING);            \
-        default: return name##_mode(&c, lo, hi, KICK_IMPLICIT_SPRINGS);                               \
+        case KICK_EXPLICIT: return name##_mode(&c, lo, hi, KICK_EXPLICIT, 0);                         \
+        case KICK_IMPLICIT_DAMPING: return name##_mode(&c, lo, hi, KICK_IMPLICIT_DAMPING, 0);         \
+        default: return name##_mode(&c, lo, hi, KICK_IMPLICIT_SPRINGS, 0);                            \
         }                                                                                             \
     }
 KICK_PASS(kick_drift_range, kick_drift_one)
@@ -336,9 +350,12 @@ typedef struct team_slot {
     char pad[64 - 3 * sizeof(size_t) - 3 * sizeof(double)];
 } team_slot;
 
+// Walls move only between calls (dem_world_set_wall_point): one that moved
+// half a skin leaves the first step to the ordinary path, whose list refresh
+// sees it.
 static int team_eligible(const dem_world *w)
 {
-    return w->list_valid && dem_forces_threaded(w) && dem_forces_blockwise(w);
+    return w->list_valid && dem_forces_threaded(w) && dem_forces_blockwise(w) && !dem_lists_walls_moved(w);
 }
 
 static size_t team_first(const team_slot *slot, int nt, int nonfinite)

@@ -26,5 +26,6 @@ int dem_wall_near_rebuild(dem_wall *wall, size_t n, const dem_vec3 *pos, const d
         else if (hl) memset(wall->hist + i * hl, 0, hl * sizeof(double));
     }
     wall->near_count = count;
+    wall->point_at_build = wall->def.point;
     return 0;
 }

@@ -21,12 +21,19 @@ typedef struct dem_wall {
     int hist_len;
     double *hist; // hist_len doubles per granule
     // Granules within one skin of this wall at the last list rebuild, in
-    // ascending order: the only ones that can touch it before the next (the
-    // solver never moves a wall, and no granule moves half a skin between
-    // rebuilds).
+    // ascending order: the only ones that can touch it before the next (no
+    // granule moves half a skin between rebuilds, nor does a wall a caller
+    // moves: dem_lists_refresh).
     uint32_t *near;
     size_t near_count, near_cap;
+    dem_vec3 point_at_build; // def.point when the near list was built: a caller may move the wall
 } dem_wall;
+
+// How far the wall has moved since its near list was built, squared.
+static inline double dem_wall_travel2(const dem_wall *wall)
+{
+    return dem_v3_norm2(dem_v3_sub(wall->def.point, wall->point_at_build));
+}
 
 // Geometry of a granule against a wall: overlap, unit normal from the granule
 // towards the wall, and the contact point on the wall surface.

@@ -80,7 +80,7 @@ void dem_world_destroy(dem_world *w)
     if (!w) return;
     void *arrays[] = {w->pos, w->vel, w->omg, w->frc, w->trq, w->rad, w->mass, w->inertia, w->inv_mass,
                       w->inv_inertia, w->id, w->pair_f, w->pair_ti, w->pair_tj, w->rev_start, w->rev_pair,
-                      w->pair_n, w->pair_g, w->damp, w->acc,
+                      w->pair_n, w->pair_g, w->damp, w->acc, w->fixed,
                       w->pos_at_build};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) free(arrays[k]);
     for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist), free(w->walls[k].near);
@@ -109,6 +109,7 @@ dem_world *dem_world_clone(const dem_world *w)
 #define DUP(field, count) c->field = dup_bytes(w->field, (count) * sizeof *w->field, &fail)
     DUP(pos, cap), DUP(vel, cap), DUP(omg, cap), DUP(frc, cap), DUP(trq, cap), DUP(rad, cap), DUP(mass, cap);
     DUP(inertia, cap), DUP(inv_mass, cap), DUP(inv_inertia, cap), DUP(id, cap), DUP(pos_at_build, cap);
+    DUP(fixed, cap);
     DUP(pair_f, pc), DUP(pair_ti, pc), DUP(pair_tj, pc), DUP(rev_pair, pc), DUP(pair_n, pc), DUP(pair_g, pc);
     DUP(damp, 6 * cap), DUP(acc, 6 * cap);
     c->imp = NULL; // scratch: allocated on the clone's first step
@@ -144,7 +145,7 @@ static int grow_granules(dem_world *w, size_t need)
     int fail = 0;
     GROW(w->pos, cap), GROW(w->vel, cap), GROW(w->omg, cap), GROW(w->frc, cap), GROW(w->trq, cap);
     GROW(w->rad, cap), GROW(w->mass, cap), GROW(w->inertia, cap), GROW(w->inv_mass, cap);
-    GROW(w->inv_inertia, cap), GROW(w->id, cap), GROW(w->pos_at_build, cap);
+    GROW(w->inv_inertia, cap), GROW(w->id, cap), GROW(w->pos_at_build, cap), GROW(w->fixed, cap);
     w->damp = realloc_or_keep(w->damp, cap * 6 * sizeof *w->damp, &fail);
     double *acc = realloc(w->acc, cap * 6 * sizeof *acc);
     if (acc) memset(acc + 6 * w->cap, 0, (cap - w->cap) * 6 * sizeof *acc), w->acc = acc;
@@ -190,6 +191,7 @@ int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity
     w->inv_mass[i] = 1.0 / m;
     w->inv_inertia[i] = 1.0 / inertia;
     w->id[i] = w->next_id++;
+    w->fixed[i] = 0;
     for (int k = 0; k < w->n_walls; ++k)
         memset(w->walls[k].hist + i * w->walls[k].hist_len, 0, w->walls[k].hist_len * sizeof(double));
     invalidate(w);
@@ -197,11 +199,11 @@ int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity
     return (int64_t)w->id[i];
 }
 
-static int wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_params *p)
+static dem_status wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_params *p)
 {
     char sub[256];
     if (dem_contact_params_check(p, sub, sizeof sub))
-        return dem_world_set_error(w, "wall '%s' contact: %s", wall->name, sub);
+        return dem_world_set_error(w, "wall '%s' contact: %s", wall->name, sub), DEM_ERR_INVALID;
     wall->def.contact = *p;
     wall->coeffs = dem_contact_coeffs_make(p);
     const unsigned old = wall->features;
@@ -210,13 +212,13 @@ static int wall_set_contact(dem_world *w, dem_wall *wall, const dem_contact_para
     if (!wall->hist || !dem_same_history_layout(old, wall->features)) { // springs restart
         size_t cap = w->cap ? w->cap : 1;
         double *h = realloc(wall->hist, cap * (size_t)(hl ? hl : 1) * sizeof *h);
-        if (!h) return dem_world_set_error(w, "out of memory for wall history");
+        if (!h) return dem_world_set_error(w, "out of memory for wall history"), DEM_ERR_NOMEM;
         wall->hist = h;
         wall->hist_len = hl;
         memset(h, 0, cap * (size_t)(hl ? hl : 1) * sizeof *h);
     }
     w->forces_valid = 0;
-    return 0;
+    return DEM_OK;
 }
 
 static int check_wall_geometry(dem_world *w, const dem_wall_def *d)
@@ -247,29 +249,53 @@ int dem_world_add_wall(dem_world *w, const dem_wall_def *def)
     return w->n_walls++;
 }
 
-void dem_world_set_wall_spin(dem_world *w, int wall, double spin)
+static int no_wall(dem_world *w, int wall)
 {
-    if (wall >= 0 && wall < w->n_walls) w->walls[wall].def.spin = spin;
-    w->forces_valid = 0;
+    return wall < 0 || wall >= w->n_walls ? dem_world_set_error(w, "no wall %d (the world has %d)", wall, w->n_walls) : 0;
 }
 
-int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)
+dem_status dem_world_set_wall_spin(dem_world *w, int wall, double spin)
+{
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
+    if (!isfinite(spin)) return dem_world_set_error(w, "wall %d: spin %g must be finite", wall, spin), DEM_ERR_INVALID;
+    w->walls[wall].def.spin = spin;
+    w->forces_valid = 0;
+    return DEM_OK;
+}
+
+// Not an invalidation: the step in progress ends with the forces it has, and
+// the next evaluation sees the wall where it now is (the wall's lists are
+// rebuilt once it has moved half a skin: dem_lists_refresh).
+dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point)
+{
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
+    if (!dem_v3_isfinite(point)) return dem_world_set_error(w, "wall %d: point must be finite", wall), DEM_ERR_INVALID;
+    w->walls[wall].def.point = point;
+    return DEM_OK;
+}
+
+const dem_wall_def *dem_world_wall(const dem_world *w, int wall)
+{
+    return wall >= 0 && wall < w->n_walls ? &w->walls[wall].def : NULL;
+}
+
+dem_status dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)
 {
     char sub[256];
     if (dem_contact_params_check(p, sub, sizeof sub))
-        return dem_world_set_error(w, "granule–granule contact: %s", sub);
+        return dem_world_set_error(w, "granule–granule contact: %s", sub), DEM_ERR_INVALID;
     unsigned old = w->features;
     w->def.granule = *p;
     refresh_features(w);
     if (!dem_same_history_layout(old, w->features)) w->list_valid = 0; // springs restart
     w->forces_valid = 0;
     w->prepared = 0;
-    return 0;
+    return DEM_OK;
 }
 
-int dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p)
+dem_status dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p)
 {
-    if (wall < 0 || wall >= w->n_walls) return dem_world_set_error(w, "no wall %d", wall);
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
     w->prepared = 0;
     return wall_set_contact(w, &w->walls[wall], p);
 }
@@ -278,7 +304,8 @@ double dem_world_min_mass(const dem_world *w) { return dem_granules_min_mass(w);
 double dem_world_min_radius(const dem_world *w) { return dem_granules_min_radius(w); }
 double dem_world_max_radius(const dem_world *w) { return dem_granules_max_radius(w); }
 
-void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx), void *ctx)
+dem_status dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx),
+                                     void *ctx)
 {
     dem_granules_view view = dem_world_granules(w);
     size_t out = 0;
@@ -289,6 +316,7 @@ void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view
         w->rad[out] = w->rad[i], w->mass[out] = w->mass[i], w->inertia[out] = w->inertia[i];
         w->inv_mass[out] = w->inv_mass[i], w->inv_inertia[out] = w->inv_inertia[i], w->id[out] = w->id[i];
         memmove(w->acc + 6 * out, w->acc + 6 * i, 6 * sizeof *w->acc);
+        w->fixed[out] = w->fixed[i];
         for (int k = 0; k < w->n_walls; ++k) {
             size_t hl = (size_t)w->walls[k].hist_len;
             memmove(w->walls[k].hist + out * hl, w->walls[k].hist + i * hl, hl * sizeof(double));
@@ -296,22 +324,43 @@ void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view
         out++;
     }
     w->n = out;
+    w->n_fixed = 0;
+    for (size_t i = 0; i < out; ++i) w->n_fixed += w->fixed[i];
     invalidate(w);
     w->prepared = 0;
+    return DEM_OK;
 }
 
-void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega)
+// Not checked for finiteness: a fault can be injected this way (the first
+// step reports it against its granule).
+dem_status dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega)
 {
-    if (i >= w->n) return;
+    if (i >= w->n) return dem_world_set_error(w, "no granule %zu (the world has %zu)", i, w->n), DEM_ERR_INVALID;
     w->vel[i] = velocity;
     w->omg[i] = omega;
     w->forces_valid = 0;
+    return DEM_OK;
 }
 
-void dem_world_freeze(dem_world *w)
+dem_status dem_world_set_granule_fixed(dem_world *w, size_t i, int fixed)
+{
+    if (i >= w->n) return dem_world_set_error(w, "no granule %zu (the world has %zu)", i, w->n), DEM_ERR_INVALID;
+    const unsigned char f = fixed != 0;
+    w->n_fixed += (size_t)f - (size_t)w->fixed[i];
+    w->fixed[i] = f;
+    if (f) w->vel[i] = w->omg[i] = dem_v3(0, 0, 0);
+    w->forces_valid = 0;
+    w->prepared = 0; // the integration is decided again (implicit springs cannot hold a granule)
+    return DEM_OK;
+}
+
+int dem_world_granule_fixed(const dem_world *w, size_t i) { return i < w->n && w->fixed[i]; }
+
+dem_status dem_world_freeze(dem_world *w)
 {
     for (size_t i = 0; i < w->n; ++i) w->vel[i] = w->omg[i] = dem_v3(0, 0, 0);
     w->forces_valid = 0;
+    return DEM_OK;
 }
 
 dem_granules_view dem_world_granules(const dem_world *w)

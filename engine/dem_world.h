@@ -34,7 +34,8 @@ typedef enum dem_lever_arm {
     DEM_LEVER_RADIUS = 1,
 } dem_lever_arm;
 
-/// Kinds of wall. Walls are never moved by the solver.
+/// Kinds of wall. Walls are never moved by the solver; a caller may move one
+/// (dem_world_set_wall_point).
 typedef enum dem_wall_kind {
     DEM_WALL_PLANE = 0,    ///< infinite plane; granules on the side `normal` points to
     DEM_WALL_DISC = 1,     ///< flat disc of `radius` (an end plate), one-sided like the plane
@@ -145,11 +146,22 @@ int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity
 /// Add a wall; returns its index, or −1.
 int dem_world_add_wall(dem_world *w, const dem_wall_def *def);
 /// Change a wall's spin (rad/s), e.g. to start a drum turning.
-void dem_world_set_wall_spin(dem_world *w, int wall, double spin);
+dem_status dem_world_set_wall_spin(dem_world *w, int wall, double spin);
+/// Prescribed wall motion: move a wall's reference point (a plane's point, a
+/// disc's centre, a point on a cylinder's axis) to `point`, e.g. before every
+/// step (a piston driven at a set speed). The step in progress ends with the
+/// forces already computed; the next force evaluation sees the wall where it
+/// now is, with its surface moving at its spin only (the move itself enters
+/// no relative velocity: a quasi-static drive). The lists are rebuilt once a
+/// wall has moved half a skin since they were built.
+dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point);
+/// A wall's definition as it now is (point and spin included); NULL for no
+/// such wall.
+const dem_wall_def *dem_world_wall(const dem_world *w, int wall);
 /// Change the granule–granule or a wall's contact parameters (calibration
 /// candidates); the feature mask is re-derived.
-int dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p);
-int dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p);
+dem_status dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p);
+dem_status dem_world_set_wall_contact(dem_world *w, int wall, const dem_contact_params *p);
 
 /// Fix the time step and check it against the stability limit. Called by
 /// the first dem_world_step; call it yourself to see the step chosen.
@@ -185,8 +197,8 @@ dem_status dem_world_check_network_dt(dem_world *w, dem_network_dt_check *out);
 dem_status dem_world_step(dem_world *w, uint64_t steps);
 
 /// Remove granules for which keep(view index) is 0 (e.g. cutting a bed).
-void dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx),
-                               void *ctx);
+dem_status dem_world_remove_granules(dem_world *w, int (*keep)(const dem_granules_view *g, size_t i, void *ctx),
+                                     void *ctx);
 
 /// Re-order the granules along a space-filling (Morton) curve so that granules
 /// in contact sit close in memory: the force loop then reads its partners from
@@ -203,10 +215,20 @@ dem_status dem_world_sort_spatially(dem_world *w);
 /// for an axis other than a periodic one, or if a granule would leave the domain.
 dem_status dem_world_rotate(dem_world *w, dem_vec3 point, dem_vec3 axis, double angle);
 
-/// Set a granule's velocity and spin (by view index).
-void dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega);
+/// Set a granule's velocity and spin (by view index); DEM_ERR_INVALID for no
+/// such granule.
+dem_status dem_world_set_granule_velocity(dem_world *w, size_t i, dem_vec3 velocity, dem_vec3 omega);
+/// Fix a granule (by view index) in place, or free it again: a fixed granule
+/// neither moves nor turns (its velocity and spin are zeroed and stay so),
+/// whatever its contacts and gravity do; its own mass enters its contacts as
+/// any granule's does (as LIGGGHTS' fix freeze). A world with fixed granules
+/// steps explicitly or with the implicit dashpot: with implicit springs
+/// dem_world_prepare refuses it (DEM_ERR_INVALID).
+dem_status dem_world_set_granule_fixed(dem_world *w, size_t i, int fixed);
+/// Whether a granule (by view index) is fixed.
+int dem_world_granule_fixed(const dem_world *w, size_t i);
 /// Zero every velocity and spin (keeps contact history).
-void dem_world_freeze(dem_world *w);
+dem_status dem_world_freeze(dem_world *w);
 
 dem_granules_view dem_world_granules(const dem_world *w);
 dem_diagnostics dem_world_diagnose(const dem_world *w);

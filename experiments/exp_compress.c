@@ -14,11 +14,6 @@
 
 #include "dem_output.h"
 #include "dem_scaling.h"
-// The engine has no call to translate a wall (its walls are "never moved by
-// the solver"; only a spin can be set). The piston is moved here by writing
-// its plane point between steps, which is all the engine reads of a plane.
-// See move_piston: the one place that touches the engine's private layout.
-#include "dem_state_internal.h"
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_pour.h"
@@ -123,7 +118,15 @@ static dem_world *create_die(const exp_compress_def *d, double gravity, char *er
     return w;
 }
 
-static void move_piston(dem_world *w, double y) { w->walls[WALL_PISTON].def.point.y = y; }
+// The piston's height: its prescribed position, moved before every step.
+static double piston_y(const dem_world *w) { return dem_world_wall(w, WALL_PISTON)->point.y; }
+
+static dem_status move_piston(dem_world *w, double y)
+{
+    dem_vec3 p = dem_world_wall(w, WALL_PISTON)->point;
+    p.y = y;
+    return dem_world_set_wall_point(w, WALL_PISTON, p);
+}
 
 // Spring forces on the piston, the floor and the side wall: the normal
 // springs k_n·h of eq. 3 (the dashpot is left out: at the quasi-static rate
@@ -197,7 +200,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
     double area = DEM_PI * 0.25 * d->diameter * d->diameter, dt = dem_world_dt(w);
     double step_travel = d->piston_speed * dt;
     uint64_t per_sample = (uint64_t)(SAMPLE_STRAIN * d->depth / step_travel) + 1;
-    double y = fmin(w->walls[WALL_PISTON].def.point.y, bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda));
+    double y = fmin(piston_y(w), bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda));
     move_piston(w, y);
     curve_buf c = {0};
     int loading = 1, cycle = 1, touched = 0, approaching = 1;
@@ -213,8 +216,8 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         double travel = approaching ? APPROACH_FACTOR * step_travel : step_travel;
         for (uint64_t s = 0; s < per_sample; ++s) {
             y += loading ? -travel : travel;
-            move_piston(w, y);
-            if (dem_world_step(w, 1) != DEM_OK) return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
+            if (move_piston(w, y) != DEM_OK || dem_world_step(w, 1) != DEM_OK)
+                return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
         }
         steps += per_sample;
         exp_compress_sample sm = {0};

@@ -309,6 +309,84 @@ static void test_wall_added_to_running_world(void **state)
     dem_world_destroy(w);
 }
 
+static void test_moved_wall_reaches_granules_off_its_list(void **state)
+{
+    (void)state;
+    // At rest 4 mm above the floor (skin 0.4 mm: not on the floor's near
+    // list). The floor is then moved up under it in one call, 0.2 mm into
+    // it: the lists must be rebuilt for the wall's travel, and push it up.
+    dem_world *w = one_granule_and_floor(5e-3, 0.0);
+    dem_wall_def floor = floor_def();
+    assert_true(dem_world_add_wall(w, &floor) >= 0);
+    assert_int_equal(dem_world_step(w, 10), DEM_OK);
+    const uint64_t rebuilds = dem_world_diagnose(w).list_rebuilds;
+    assert_int_equal(dem_world_set_wall_point(w, 0, dem_v3(0, 4.2e-3, 0)), DEM_OK);
+    assert_true(dem_world_wall(w, 0)->point.y == 4.2e-3);
+    assert_int_equal(dem_world_step(w, 2), DEM_OK);
+    dem_granules_view g = dem_world_granules(w);
+    printf("floor moved 4.2 mm up into a granule off its near list: %llu rebuild(s), vy %+.4f m/s\n",
+           (unsigned long long)(dem_world_diagnose(w).list_rebuilds - rebuilds), g.velocity[0].y);
+    assert_true(dem_world_diagnose(w).list_rebuilds > rebuilds);
+    assert_true(g.velocity[0].y > 0.0);
+    assert_int_equal(dem_world_set_wall_point(w, 1, dem_v3(0, 0, 0)), DEM_ERR_INVALID);
+    assert_null(dem_world_wall(w, 1));
+    dem_world_destroy(w);
+}
+
+// ------------------------------------------------------ fixed granules ---
+
+// A granule dropped onto a fixed one, under gravity: the fixed one stays
+// where it was, bit for bit, through a spatial sort and a clone; the other
+// comes to rest on it.
+static void test_fixed_granule_holds(void **state)
+{
+    (void)state;
+    dem_world_def def = dem_default_world_def();
+    def.domain_lo = dem_v3(-0.01, -0.01, -0.01);
+    def.domain_hi = dem_v3(0.01, 0.05, 0.01);
+    dem_world *w = dem_world_create(&def, NULL, 0);
+    assert_non_null(w);
+    const dem_vec3 base = dem_v3(1e-4, 0, 0);
+    assert_true(dem_world_add_granule(w, dem_v3(0, 3e-3, 0), dem_v3(0, 0, 0), dem_v3(0, 0, 0), 1e-3, 1800) >= 0);
+    assert_true(dem_world_add_granule(w, base, dem_v3(0, 0.1, 0), dem_v3(0, 0, 1), 1e-3, 1800) >= 0);
+    assert_int_equal(dem_world_set_granule_fixed(w, 1, 1), DEM_OK);
+    assert_true(dem_world_granule_fixed(w, 1) && !dem_world_granule_fixed(w, 0));
+    assert_int_equal(dem_world_set_granule_fixed(w, 2, 1), DEM_ERR_INVALID);
+    assert_int_equal(dem_world_sort_spatially(w), DEM_OK);
+    assert_int_equal(dem_world_step(w, (uint64_t)(0.05 / dem_world_dt(w))), DEM_OK);
+    dem_world *c = dem_world_clone(w);
+    assert_non_null(c);
+    assert_int_equal(dem_world_step(c, (uint64_t)(0.05 / dem_world_dt(c))), DEM_OK);
+    dem_granules_view g = dem_world_granules(c);
+    const size_t f = index_of(&g, 1), m = index_of(&g, 0);
+    printf("granule dropped on a fixed one: fixed at (%g, %g, %g), speed %g; the other at y = %.4e m, vy %+.2e m/s\n",
+           g.position[f].x, g.position[f].y, g.position[f].z, dem_v3_norm(g.velocity[f]), g.position[m].y,
+           g.velocity[m].y);
+    assert_true(dem_world_granule_fixed(c, f));
+    assert_vec_equal(g.position[f], base);
+    assert_vec_equal(g.velocity[f], dem_v3(0, 0, 0));
+    assert_vec_equal(g.omega[f], dem_v3(0, 0, 0));
+    assert_true(g.position[m].y > 1.5e-3 && fabs(g.velocity[m].y) < 0.05); // resting on it
+    dem_world_destroy(c);
+    dem_world_destroy(w);
+}
+
+static void test_fixed_granules_refuse_implicit_springs(void **state)
+{
+    (void)state;
+    dem_world_def def = dem_default_world_def();
+    def.implicit_springs = 1;
+    dem_world *w = dem_world_create(&def, NULL, 0);
+    assert_non_null(w);
+    assert_true(dem_world_add_granule(w, dem_v3(0, 0, 0), dem_v3(0, 0, 0), dem_v3(0, 0, 0), 1e-3, 1800) >= 0);
+    assert_int_equal(dem_world_set_granule_fixed(w, 0, 1), DEM_OK);
+    assert_int_equal(dem_world_prepare(w), DEM_ERR_INVALID);
+    printf("fixed granule, implicit springs asked for: %s\n", dem_world_error(w));
+    assert_int_equal(dem_world_set_granule_fixed(w, 0, 0), DEM_OK);
+    assert_int_equal(dem_world_prepare(w), DEM_OK);
+    dem_world_destroy(w);
+}
+
 // ------------------------------------------------------ spring layout swap ---
 
 // Rolling spring energy of the pair: the elastic energy less the normal spring's.
@@ -478,6 +556,9 @@ int main(void)
         cmocka_unit_test(test_rotation_turns_the_springs_with_the_bed),
         cmocka_unit_test(test_refused_rotation_changes_nothing),
         cmocka_unit_test(test_world_threads_are_its_own),
+        cmocka_unit_test(test_moved_wall_reaches_granules_off_its_list),
+        cmocka_unit_test(test_fixed_granule_holds),
+        cmocka_unit_test(test_fixed_granules_refuse_implicit_springs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
