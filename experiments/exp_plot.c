@@ -7,6 +7,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <plplot.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -568,6 +569,21 @@ static void grid_range(map_grid *g)
     if (g->filled && g->zhi - g->zlo < 1e-9) g->zlo -= 0.5, g->zhi += 0.5;
 }
 
+// qhull, under plgriddata's triangulation, ends the process on input whose
+// first sites lie on one circle (a search's 2 × 2 start grid is a square), so
+// every site is moved by a fixed pseudo-random amount of at most 1e-7 of the
+// axes: no four sites stay exactly cocircular, and no pixel moves.
+static void joggle(size_t n, double *u, double *v)
+{
+    uint64_t s = 0x2545F4914F6CDD1Dull;
+    for (size_t k = 0; k < n; ++k) {
+        s = s * 6364136223846793005ull + 1442695040888963407ull;
+        u[k] += 1e-7 * ((double)(s >> 11) / 9007199254740992.0 - 0.5);
+        s = s * 6364136223846793005ull + 1442695040888963407ull;
+        v[k] += 1e-7 * ((double)(s >> 11) / 9007199254740992.0 - 0.5);
+    }
+}
+
 static void interpolate(const exp_plot_map *m, map_grid *g)
 {
     for (int i = 0; i < MAP_NODES; ++i) g->z[i] = g->storage + (size_t)i * MAP_NODES;
@@ -576,6 +592,7 @@ static void interpolate(const exp_plot_map *m, map_grid *g)
     double *u = malloc(cap * sizeof *u), *v = malloc(cap * sizeof *v), *z = malloc(cap * sizeof *z);
     size_t n = u && v && z ? unit_points(m, g, u, v, z) : 0;
     if (n >= 3 && spans_area(n, u, v)) {
+        joggle(n, u, v);
         double nodes[MAP_NODES];
         for (int i = 0; i < MAP_NODES; ++i) nodes[i] = (double)i / (MAP_NODES - 1);
         plgriddata(u, v, z, (PLINT)n, nodes, MAP_NODES, nodes, MAP_NODES, g->z, GRID_DTLI, 0);

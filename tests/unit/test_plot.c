@@ -207,6 +207,20 @@ static void map_of_too_few_points(void **state)
     assert_figure("map_two_points.png", 5000, 3);
 }
 
+// A search's 2 × 2 start grid alone: four sites on one circle, which the
+// triangulation under plgriddata (qhull) refused by ending the process.
+static void map_of_a_square_grid(void **state)
+{
+    double x[4] = {0.325, 0.325, 0.775, 0.775}, y[4] = {1.5e-4, 0.0334, 1.5e-4, 0.0334}, z[4] = {38.4, 37.2, 38.7, 39.1};
+    exp_plot_map m = {.title = "2 × 2 grid", .xlabel = "μs", .ylabel = "μr", .n = 4, .x = x, .y = y, .z = z,
+                      .xlo = 0.1, .xhi = 1, .ylo = 1e-5, .yhi = 0.5, .log_y = 1, .band_lo = 37, .band_hi = 38.5,
+                      .band_label = "band", .chosen = 2};
+    char path[1200], err[512];
+    path_in_dir(path, sizeof path, "map_square_grid.png");
+    if (exp_plot_map_png(path, &m, 900, 700, err, sizeof err)) fail_msg("%s", err);
+    assert_figure("map_square_grid.png", 10000, 10);
+}
+
 // ---- failures ------------------------------------------------------------------------
 
 static void unwritable_path_is_an_error_naming_it(void **state)
@@ -238,6 +252,7 @@ int main(void)
         cmocka_unit_test(stiffness_sweep),
         cmocka_unit_test(friction_figures),
         cmocka_unit_test(map_of_too_few_points),
+        cmocka_unit_test(map_of_a_square_grid),
         cmocka_unit_test(unwritable_path_is_an_error_naming_it),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
