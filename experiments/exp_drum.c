@@ -304,16 +304,27 @@ typedef struct turn_state {
 
 enum { MEASURE_DOUBLES = 4 };
 // The slots of the checkpoint's "turn" array, one home for save and resume.
-enum { TURN_T0, TURN_STEPS, TURN_WALL_S, TURN_START_TILT, TURN_STEADY_FROM, TURN_STEADY_AT, TURN_DOUBLES };
+enum {
+    TURN_T0,
+    TURN_STEPS,
+    TURN_WALL_S,
+    TURN_START_TILT,
+    TURN_STEADY_FROM,
+    TURN_STEADY_AT,
+    TURN_DT_MARGIN, // the network checks so far: a resumed run reports the whole run's
+    TURN_DT_LOWERED,
+    TURN_DOUBLES
+};
 _Static_assert(sizeof(exp_drum_measure) == MEASURE_DOUBLES * sizeof(double), "a measurement is saved as 4 doubles");
 
-static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_state *s, double wall_s, char *err,
-                     size_t len)
+static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_state *s, const exp_drum_result *out,
+                     double wall_s, char *err, size_t len)
 {
     double turn[TURN_DOUBLES];
     turn[TURN_T0] = s->t0, turn[TURN_STEPS] = (double)s->steps, turn[TURN_WALL_S] = s->earlier_wall_s + wall_s;
     turn[TURN_START_TILT] = o->start_tilt_deg;
     turn[TURN_STEADY_FROM] = s->steady_from, turn[TURN_STEADY_AT] = s->steady_at;
+    turn[TURN_DT_MARGIN] = out->dt_margin_min, turn[TURN_DT_LOWERED] = out->dt_lowered;
     dem_checkpoint_array extra[2] = {{"turn", turn, TURN_DOUBLES},
                                      {"measurements", (double *)s->m, (size_t)s->count * MEASURE_DOUBLES}};
     return dem_checkpoint_write(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, len);
@@ -333,6 +344,7 @@ static int resume_turn(dem_world *w, const exp_drum_run_opts *o, turn_state *s, 
         s->t0 = turn[TURN_T0], s->steps = (uint64_t)turn[TURN_STEPS], s->earlier_wall_s = turn[TURN_WALL_S];
         out->start_tilt_deg = turn[TURN_START_TILT];
         s->steady_from = (int)turn[TURN_STEADY_FROM], s->steady_at = (int)turn[TURN_STEADY_AT];
+        out->dt_margin_min = turn[TURN_DT_MARGIN], out->dt_lowered = (int)turn[TURN_DT_LOWERED];
         s->count = (int)(extra[1].count / MEASURE_DOUBLES);
         memcpy(s->m, extra[1].data, extra[1].count * sizeof(double));
     } else if (rc != 1)
@@ -388,6 +400,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
                            void *ctx, exp_drum_result *out)
 {
     memset(out, 0, sizeof *out);
+    out->dt_margin_min = NAN; // no check yet (a resumed run takes its checkpoint's)
     int per_window = (int)(o->window / o->sample_interval + 0.5);
     int avg_samples = (int)(o->average_time / o->sample_interval + 0.5);
     turn_state s = {.cap = (int)(o->max_time / o->sample_interval) + 2, .steady_from = -1};
@@ -399,7 +412,6 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     out->earlier_wall_s = s.earlier_wall_s;
     uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
-    out->dt_margin_min = NAN;
     while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval &&
            !(s.steady_from >= 0 && s.count - s.steady_at >= avg_samples)) {
         st = dem_world_step(w, chunk);
@@ -417,7 +429,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
         double now = exp_wall_seconds();
         if (o->checkpoint && now - saved >= o->checkpoint->every_s) {
             // A checkpoint that cannot be written costs the resume, not the run.
-            if (save_turn(w, o, &s, now - started, out->checkpoint_note, sizeof out->checkpoint_note) == 0)
+            if (save_turn(w, o, &s, out, now - started, out->checkpoint_note, sizeof out->checkpoint_note) == 0)
                 out->checkpoint_note[0] = '\0';
             saved = now;
         }

@@ -133,9 +133,10 @@ typedef struct exp_drum_result {
     double earlier_wall_s;
     double averaged_time_s;      ///< s of turning the means and spreads are over
     double measure_wall_s;       ///< wall seconds of this call spent measuring the drum face
-    /// The smallest network limit over the step seen by the checks of this
-    /// call (NAN: none made), how often the step had to be lowered, and the
-    /// wall seconds the checks took.
+    /// The smallest network limit over the step seen by the run's checks
+    /// (NAN: none made; a resumed run counts those before its checkpoint),
+    /// how often the step had to be lowered, and the wall seconds the checks
+    /// of this call took.
     double dt_margin_min;
     int dt_lowered;
     double network_check_wall_s;
