@@ -143,10 +143,6 @@ static void show_done(const cal_env *env, const char *what, const cal_record *r)
             progress[0] ? "; " : "", progress);
 }
 
-// What a record's simulation cost to run: its turning or pouring, and the
-// settling charged to it.
-static double record_cost_s(const cal_record *r) { return r->wall_time_s + r->fill_wall_time_s; }
-
 // A record every rank must find once a batch is done.
 static int read_back(const cal_env *env, const char *key, cal_record *out, char *err, size_t len)
 {
@@ -307,7 +303,7 @@ static void finish_run(cal_env *env, cal_run_kind kind, const char *key, const c
         write_failed_record(env, key, reason, outside);
     }
     if (cal_store_get(env->store, key, &r, err, sizeof err) == 0) {
-        cal_progress_count(env->progress, kind, record_cost_s(&r));
+        cal_progress_count(env->progress, kind, cal_record_cost_s(&r));
         show_done(env, what, &r);
         cal_record_free(&r);
     } else cal_progress_count(env->progress, kind, NAN);
@@ -404,7 +400,7 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
 // A record found in the store: a simulation done, at the cost it had; then released.
 static void count_stored(cal_env *env, cal_run_kind kind, cal_record *r)
 {
-    cal_progress_count(env->progress, kind, record_cost_s(r));
+    cal_progress_count(env->progress, kind, cal_record_cost_s(r));
     cal_record_free(r);
 }
 
@@ -441,7 +437,8 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     int read = 0;
     while (!bad && read < runs) bad = read_back(env, b.keys[read], &out[read], err, len), read += !bad;
     for (int i = 0; i < n_missing && !bad; ++i) // other ranks' runs
-        if (!ran_here(&b, missing[i])) cal_progress_count(env->progress, CAL_RUN_DRUM, record_cost_s(&out[missing[i].c * n + missing[i].k]));
+        if (!ran_here(&b, missing[i]))
+            cal_progress_count(env->progress, CAL_RUN_DRUM, cal_record_cost_s(&out[missing[i].c * n + missing[i].k]));
     if (bad) // the caller gets no records: release those read
         while (read > 0) cal_record_free(&out[--read]);
     free(b.keys), free(b.todo), free(b.case_todo), free(missing);
@@ -514,7 +511,7 @@ int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, ca
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
         bad = read_back(env, keys[k], &out[k], err, len);
-        if (!bad && missing[k]) cal_progress_count(env->progress, CAL_RUN_CYLINDER, record_cost_s(&out[k])); // another rank's
+        if (!bad && missing[k]) cal_progress_count(env->progress, CAL_RUN_CYLINDER, cal_record_cost_s(&out[k])); // another rank's
     }
     free(keys), free(todo), free(missing);
     return bad;

@@ -142,7 +142,7 @@ static void add_candidate(search *s, double mu_s, double mu_r, const char *origi
     k->mu_s = mu_s, k->mu_r = mu_r, k->origin = origin;
     score(s, k, rec);
     for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
-        k->wall_time_s += rec[i].wall_time_s + rec[i].fill_wall_time_s, cal_record_free(&rec[i]);
+        k->wall_time_s += cal_record_cost_s(&rec[i]), cal_record_free(&rec[i]);
     char with_angle[48] = "", took[48];
     if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", with the angle %.3g", k->objective);
     if (together > 1) snprintf(took, sizeof took, "%.0f s for the %d together", elapsed, together);

@@ -123,4 +123,6 @@ void cal_record_free(cal_record *r)
     r->key = r->status = r->reason = r->writer = NULL;
 }
 
+double cal_record_cost_s(const cal_record *r) { return r->wall_time_s + r->fill_wall_time_s; }
+
 int cal_record_usable(const cal_record *r) { return r->status && strcmp(r->status, "failed") != 0; }

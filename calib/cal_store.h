@@ -49,6 +49,10 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len);
 
 void cal_record_free(cal_record *r);
 
+/// What the record's simulation cost to run, wall seconds: its turn or pour,
+/// and the settling charged to it.
+double cal_record_cost_s(const cal_record *r);
+
 /// 1 if the record holds a usable measurement (not failed).
 int cal_record_usable(const cal_record *r);
 

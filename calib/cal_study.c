@@ -214,7 +214,7 @@ static int measure_rung(study *s, rung_result *out)
         if (cal_drum_evaluate(&s->env, &d, f->rpm, (int)f->rpm_count, rec, s->err, sizeof s->err)) return 1;
         for (unsigned k = 0; k < f->rpm_count; ++k) {
             const cal_record *r = &rec[k];
-            out->wall_s += r->wall_time_s + r->fill_wall_time_s;
+            out->wall_s += cal_record_cost_s(r);
             out->runs++;
             out->particle_steps += r->particle_steps;
             out->peak_rss_mb = fmax(out->peak_rss_mb, r->peak_rss_mb);
