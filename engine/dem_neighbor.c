@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_memory_internal.h"
 #include "dem_neighbor_internal.h"
 #include "dem_threads_internal.h"
 
@@ -272,23 +273,14 @@ double dem_nl_max_displacement2(const dem_domain *dom, const dem_vec3 *pos, cons
     return m;
 }
 
-static void *dup_bytes(const void *src, size_t bytes, int *fail)
-{
-    if (!src || bytes == 0) return NULL;
-    void *d = malloc(bytes);
-    if (!d) *fail = 1;
-    else memcpy(d, src, bytes);
-    return d;
-}
-
 void dem_nl_clone(dem_neighbor_list *dst, const dem_neighbor_list *src, int *fail)
 {
     *dst = *src;
-    dst->start = dup_bytes(src->start, src->start ? (src->rows + 1) * sizeof *src->start : 0, fail);
-    dst->j = dup_bytes(src->j, src->cap * sizeof *src->j, fail);
-    dst->row = dup_bytes(src->row, src->cap * sizeof *src->row, fail);
-    dst->constants = dup_bytes(src->constants, src->cap * sizeof *src->constants, fail);
-    dst->hist = dup_bytes(src->hist, src->hist_cap * sizeof *src->hist, fail);
+    dst->start = dem_dup_bytes(src->start, src->start ? (src->rows + 1) * sizeof *src->start : 0, fail);
+    dst->j = dem_dup_bytes(src->j, src->cap * sizeof *src->j, fail);
+    dst->row = dem_dup_bytes(src->row, src->cap * sizeof *src->row, fail);
+    dst->constants = dem_dup_bytes(src->constants, src->cap * sizeof *src->constants, fail);
+    dst->hist = dem_dup_bytes(src->hist, src->hist_cap * sizeof *src->hist, fail);
 }
 
 void dem_nl_free(dem_neighbor_list *nl)

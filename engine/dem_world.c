@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "dem_implicit_internal.h"
+#include "dem_memory_internal.h"
 #include "dem_state_internal.h"
 
 dem_world_def dem_default_world_def(void)
@@ -90,15 +91,6 @@ void dem_world_destroy(dem_world *w)
     free(w);
 }
 
-static void *dup_bytes(const void *src, size_t bytes, int *fail)
-{
-    if (!src || bytes == 0) return NULL;
-    void *d = malloc(bytes);
-    if (!d) *fail = 1;
-    else memcpy(d, src, bytes);
-    return d;
-}
-
 dem_world *dem_world_clone(const dem_world *w)
 {
     dem_world *c = malloc(sizeof *c);
@@ -106,7 +98,7 @@ dem_world *dem_world_clone(const dem_world *w)
     *c = *w;
     int fail = 0;
     size_t cap = w->cap, pc = w->pair_cap;
-#define DUP(field, count) c->field = dup_bytes(w->field, (count) * sizeof *w->field, &fail)
+#define DUP(field, count) c->field = dem_dup_bytes(w->field, (count) * sizeof *w->field, &fail)
     DUP(pos, cap), DUP(vel, cap), DUP(omg, cap), DUP(frc, cap), DUP(trq, cap), DUP(rad, cap), DUP(mass, cap);
     DUP(inertia, cap), DUP(inv_mass, cap), DUP(inv_inertia, cap), DUP(id, cap), DUP(pos_at_build, cap);
     DUP(fixed, cap);
@@ -118,8 +110,8 @@ dem_world *dem_world_clone(const dem_world *w)
     for (int k = 0; k < w->n_walls; ++k) {
         c->walls[k].def.name = c->walls[k].name;
         size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
-        c->walls[k].hist = dup_bytes(w->walls[k].hist, (cap ? cap : 1) * hl * sizeof(double), &fail);
-        c->walls[k].near = dup_bytes(w->walls[k].near, w->walls[k].near_cap * sizeof *w->walls[k].near, &fail);
+        c->walls[k].hist = dem_dup_bytes(w->walls[k].hist, (cap ? cap : 1) * hl * sizeof(double), &fail);
+        c->walls[k].near = dem_dup_bytes(w->walls[k].near, w->walls[k].near_cap * sizeof *w->walls[k].near, &fail);
     }
     dem_nl_clone(&c->nl, &w->nl, &fail);
     dem_nl_clone(&c->nl_old, &w->nl_old, &fail);
