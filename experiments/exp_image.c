@@ -92,8 +92,7 @@ int exp_otsu_threshold(const unsigned long hist[256])
     return threshold;
 }
 
-exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius, int invert, double *threshold,
-                           char *err, size_t len)
+unsigned char *exp_read_gray_png(const char *path, int *w, int *h, char *err, size_t len)
 {
     png_image img;
     memset(&img, 0, sizeof img);
@@ -110,7 +109,16 @@ exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius
         png_image_free(&img);
         return NULL;
     }
-    int w = (int)img.width, h = (int)img.height;
+    *w = (int)img.width, *h = (int)img.height;
+    return gray;
+}
+
+exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius, int invert, double *threshold,
+                           char *err, size_t len)
+{
+    int w, h;
+    unsigned char *gray = exp_read_gray_png(path, &w, &h, err, len);
+    if (!gray) return NULL;
     if (!(radius > 1) || cx - radius < -0.5 || cy - radius < -0.5 || cx + radius > w + 0.5 || cy + radius > h + 0.5) {
         snprintf(err, len, "%s: the drum circle (centre %g,%g, radius %g px) must lie inside the %dx%d image", path,
                  cx, cy, radius, w, h);

@@ -27,6 +27,11 @@ int exp_render_drum_png(const char *path, const dem_world *w, double drum_radius
 exp_raster *exp_read_photo(const char *path, double cx, double cy, double radius, int invert, double *threshold,
                            char *err, size_t len);
 
+/// Read a PNG of any colour type as 8-bit grey (libpng's conversion),
+/// row-major, image y downwards: w × h bytes to free. NULL with a message
+/// naming the file when it cannot be read or decoded.
+unsigned char *exp_read_gray_png(const char *path, int *w, int *h, char *err, size_t len);
+
 /// Otsu's threshold over a 256-bin histogram: the grey level that
 /// separates the two classes with the largest between-class variance.
 int exp_otsu_threshold(const unsigned long hist[256]);

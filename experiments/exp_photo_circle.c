@@ -9,10 +9,11 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_multifit.h>
 #include <math.h>
-#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "exp_image.h"
 
 #define PI 3.14159265358979323846
 #define EDGE_SMOOTH_PX 1.5     // Gaussian sigma before edges: single-pixel pores and noise fade, rims stay
@@ -22,26 +23,19 @@
 
 exp_gray *exp_gray_read_png(const char *path, char *err, size_t len)
 {
-    png_image img;
-    memset(&img, 0, sizeof img);
-    img.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&img, path)) {
-        snprintf(err, len, "%s: cannot read as PNG: %s", path, img.message);
-        return NULL;
-    }
-    img.format = PNG_FORMAT_GRAY;
-    unsigned char *bytes = malloc(PNG_IMAGE_SIZE(img));
+    int w, h;
+    unsigned char *bytes = exp_read_gray_png(path, &w, &h, err, len);
+    if (!bytes) return NULL;
     exp_gray *g = calloc(1, sizeof *g);
-    if (g) g->v = malloc((size_t)img.width * img.height * sizeof *g->v);
-    if (!bytes || !g || !g->v || !png_image_finish_read(&img, NULL, bytes, 0, NULL)) {
-        snprintf(err, len, "%s: cannot decode: %s", path, bytes && g && g->v ? img.message : "out of memory");
-        png_image_free(&img);
+    if (g) g->v = malloc((size_t)w * h * sizeof *g->v);
+    if (!g || !g->v) {
+        snprintf(err, len, "%s: cannot decode: out of memory", path);
         free(bytes);
         exp_gray_free(g);
         return NULL;
     }
-    g->w = (int)img.width, g->h = (int)img.height;
-    for (size_t k = 0; k < (size_t)g->w * g->h; ++k) g->v[k] = bytes[k];
+    g->w = w, g->h = h;
+    for (size_t k = 0; k < (size_t)w * h; ++k) g->v[k] = bytes[k];
     free(bytes);
     return g;
 }
