@@ -51,6 +51,8 @@ static const char help[] =
     "  --stage STAGE      all (default), stiffness, granule or wall; a later stage reads\n"
     "                     the earlier stages' results from OUT, else the config's values\n"
     "  --material NAME    fit this wall material only (implies --stage wall)\n"
+    "  --data DIR         read DIR/repose_angle.csv and DIR/occupied_area.csv instead of\n"
+    "                     the config's files (e.g. a twin made by granucal synthesize)\n"
     "  --out DIR          results folder (default results/<config>-<tier>)\n"
     "  --jobs N           simulations side by side on this machine (default: cores)\n"
     "  --checkpoint-every S  wall seconds between a drum run's checkpoints (default 120;\n"
@@ -75,7 +77,7 @@ static const char help[] =
     "liggghts_parameters.in, lammps_parameters.in.\n";
 
 typedef struct options {
-    const char *config, *tier, *stage, *material, *out;
+    const char *config, *tier, *stage, *material, *out, *data;
     int jobs;
     double checkpoint_every_s;
 } options;
@@ -84,7 +86,8 @@ static int parse_options(int argc, char **argv, options *o)
 {
     static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
                                           {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
-                                          {"checkpoint-every", 1, 0, 'c'}, {0, 0, 0, 0}};
+                                          {"checkpoint-every", 1, 0, 'c'}, {"data", 1, 0, 'd'},
+                                          {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     o->jobs = ncpu > 0 ? (int)ncpu : 1;
@@ -97,6 +100,7 @@ static int parse_options(int argc, char **argv, options *o)
         case 's': o->stage = optarg; break;
         case 'm': o->material = optarg, o->stage = "wall"; break;
         case 'o': o->out = optarg; break;
+        case 'd': o->data = optarg; break;
         case 'j':
             if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024))
                 return fprintf(stderr, "granucal calibrate: --jobs '%s': expected a whole number in 1..1024\n", optarg), 2;
@@ -122,12 +126,15 @@ static int parse_options(int argc, char **argv, options *o)
 typedef struct stage_file {
     double k_n, mu_s, mu_r;
     double mu_s_identified_min, mu_s_identified_max, mu_r_identified_min, mu_r_identified_max; ///< absent: 0
+    double mu_s_not_excluded_min, mu_s_not_excluded_max, mu_r_not_excluded_min, mu_r_not_excluded_max; ///< absent: 0
 } stage_file;
 #define STAGE_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, stage_file, member)
 static const cyaml_schema_field_t stage_fields[] = {
     STAGE_FLOAT("k_n", k_n), STAGE_FLOAT("mu_s", mu_s), STAGE_FLOAT("mu_r", mu_r),
     STAGE_FLOAT("mu_s_identified_min", mu_s_identified_min), STAGE_FLOAT("mu_s_identified_max", mu_s_identified_max),
     STAGE_FLOAT("mu_r_identified_min", mu_r_identified_min), STAGE_FLOAT("mu_r_identified_max", mu_r_identified_max),
+    STAGE_FLOAT("mu_s_not_excluded_min", mu_s_not_excluded_min), STAGE_FLOAT("mu_s_not_excluded_max", mu_s_not_excluded_max),
+    STAGE_FLOAT("mu_r_not_excluded_min", mu_r_not_excluded_min), STAGE_FLOAT("mu_r_not_excluded_max", mu_r_not_excluded_max),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t stage_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, stage_file, stage_fields)};
 
@@ -143,18 +150,23 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
             k_n, mu_s, mu_r);
     if (ranges && isfinite(ranges[1].lo))
         fprintf(a.f, "mu_s_identified_min: %.17g\nmu_s_identified_max: %.17g\nmu_r_identified_min: %.17g\n"
-                     "mu_r_identified_max: %.17g\n",
-                ranges[0].lo, ranges[0].hi, ranges[1].lo, ranges[1].hi);
+                     "mu_r_identified_max: %.17g\nmu_s_not_excluded_min: %.17g\nmu_s_not_excluded_max: %.17g\n"
+                     "mu_r_not_excluded_min: %.17g\nmu_r_not_excluded_max: %.17g\n",
+                ranges[0].lo, ranges[0].hi, ranges[1].lo, ranges[1].hi, ranges[0].bracket_lo, ranges[0].bracket_hi,
+                ranges[1].bracket_lo, ranges[1].bracket_hi);
     return cal_atomic_commit(&a, err, len);
 }
 
 // The identified ranges a stage file kept (NAN if none: μr's range is never 0).
 static void stage_ranges(const stage_file *s, cal_range *mu_s, cal_range *mu_r)
 {
-    *mu_s = *mu_r = (cal_range){NAN, NAN, NAN, NAN};
+    *mu_s = *mu_r = CAL_NO_RANGE;
     if (!(s->mu_r_identified_min > 0)) return;
     mu_s->lo = s->mu_s_identified_min, mu_s->hi = s->mu_s_identified_max;
     mu_r->lo = s->mu_r_identified_min, mu_r->hi = s->mu_r_identified_max;
+    if (!(s->mu_r_not_excluded_min > 0)) return; // a stage file written before the bracket was kept
+    mu_s->bracket_lo = s->mu_s_not_excluded_min, mu_s->bracket_hi = s->mu_s_not_excluded_max;
+    mu_r->bracket_lo = s->mu_r_not_excluded_min, mu_r->bracket_hi = s->mu_r_not_excluded_max;
 }
 
 // 1 if the stage file exists and was read; -1 if it is damaged.
@@ -203,9 +215,11 @@ static int prepare(run *r)
     r->c = cal_config_load(r->opt.config, r->opt.tier, r->err, sizeof r->err);
     if (!r->c) return 1;
     r->t = cal_config_tier(r->c);
-    cal_config_data_path(r->c, r->c->repose_angle, path, sizeof path);
+    if (r->opt.data) snprintf(path, sizeof path, "%s/repose_angle.csv", r->opt.data);
+    else cal_config_data_path(r->c, r->c->repose_angle, path, sizeof path);
     if (cal_series_load(&r->angles, path, CAL_DATA_ANGLE, r->err, sizeof r->err)) return 1;
-    cal_config_data_path(r->c, r->c->occupied_area, path, sizeof path);
+    if (r->opt.data) snprintf(path, sizeof path, "%s/occupied_area.csv", r->opt.data);
+    else cal_config_data_path(r->c, r->c->occupied_area, path, sizeof path);
     if (cal_series_load(&r->areas, path, CAL_DATA_CSA, r->err, sizeof r->err)) return 1;
     if (check_surface(&r->angles, &r->areas, r->c->granule_surface, r->err, sizeof r->err)) return 1;
     int found = r->opt.material == NULL;
@@ -260,6 +274,21 @@ static const char *friction_source(const cal_friction_result *f, const char *con
     return f->best_feasible ? sources[0] : f->angle_in_misfit ? sources[1] : sources[2];
 }
 
+// One friction stage: across two tiers where the tier names a map tier.
+static int friction_stage(run *r, double k_n, const cal_material *m, double gg_mu_s, double gg_mu_r,
+                          cal_friction_result *out)
+{
+    if (!r->t->map_tier)
+        return cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, out, r->err,
+                                  sizeof r->err);
+    cal_friction_result *cheap = calloc(1, sizeof *cheap);
+    if (!cheap) return exp_fail(r->err, sizeof r->err, "out of memory");
+    int bad = cal_stage_two_tier(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, out, cheap,
+                                 r->err, sizeof r->err);
+    free(cheap);
+    return bad;
+}
+
 static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const char **source)
 {
     *mu_s = r->c->granule_mu_s, *mu_r = r->c->granule_mu_r, *source = "config granule_mu_s/mu_r (stage 2 not run)";
@@ -267,9 +296,7 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
         fprintf(stderr, "== stage 2: granule-granule friction (k_n = %g N/m, drum λ = %g)\n", k_n, r->t->lambda);
         r->granule = calloc(1, sizeof *r->granule);
         if (!r->granule) return exp_fail(r->err, sizeof r->err, "out of memory");
-        if (cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, NULL, 0, 0, r->granule, r->err,
-                               sizeof r->err))
-            return 1;
+        if (friction_stage(r, k_n, NULL, 0, 0, r->granule)) return 1;
         const cal_candidate *b = &r->granule->cand[r->granule->best];
         *mu_s = b->mu_s, *mu_r = b->mu_r;
         r->table.gg_mu_s_range = r->granule->mu_s_range, r->table.gg_mu_r_range = r->granule->mu_r_range;
@@ -300,9 +327,7 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
                 gg_mu_s, gg_mu_r);
         cal_friction_result *w = r->walls[r->n_walls++] = calloc(1, sizeof *w);
         if (!w) return exp_fail(r->err, sizeof r->err, "out of memory");
-        if (cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, w, r->err,
-                               sizeof r->err))
-            return 1;
+        if (friction_stage(r, k_n, m, gg_mu_s, gg_mu_r, w)) return 1;
         int t = r->table.n_walls++;
         snprintf(r->table.wall_name[t], 32, "%s", m->name);
         r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
@@ -348,7 +373,7 @@ static int calibrate(run *r, const char *command)
     const char *k_source, *gg_source;
     r->env.started = exp_wall_seconds();
     plan_progress(r);
-    r->table.gg_mu_s_range = r->table.gg_mu_r_range = (cal_range){NAN, NAN, NAN, NAN}; // until stage 2 says
+    r->table.gg_mu_s_range = r->table.gg_mu_r_range = CAL_NO_RANGE; // until stage 2 says
     if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
         stage_walls(r, k_n, gg_mu_s, gg_mu_r))
         return 1;

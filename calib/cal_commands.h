@@ -8,6 +8,7 @@ int cal_cmd_simulate(int argc, char **argv);
 int cal_cmd_measure(int argc, char **argv);
 int cal_cmd_calibrate(int argc, char **argv);
 int cal_cmd_study(int argc, char **argv);
+int cal_cmd_synthesize(int argc, char **argv);
 
 /// Run a drum experiment config with `--set` overrides, at the config's rpm or
 /// at each of `rpm_list` ("4,40,80") from one settled bed; results in `out`.

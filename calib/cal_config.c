@@ -44,13 +44,13 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
     CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
     TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
-    TIER_FLOAT("angle_offset_deg", angle_offset_deg, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
     CYAML_FIELD_SEQUENCE("csa_sd_percent", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, csa_sd_percent,
                          &float_entry, 1, 32),
     // _PTR: the plain ENUM macro drops CYAML_FLAG_POINTER and would write the value into the pointer itself.
     CYAML_FIELD_ENUM_PTR("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, bound_probes, yes_no,
                          CYAML_ARRAY_LEN(yes_no)),
+    CYAML_FIELD_STRING_PTR("map_tier", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, map_tier, 1, 31),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -187,6 +187,22 @@ static int check_drum_knobs(const cal_config *c, int from, double lambda, double
     return 0;
 }
 
+// The map tier exists, is another tier, maps by itself (no chains), and turns
+// the same speeds (the correction is per measurement: one per speed).
+static int check_map_tier(const cal_config *c, const cal_tier *t, int from, char *err, size_t len)
+{
+    const cal_tier *m = cal_config_tier_named(c, t->map_tier);
+    if (!m) return located(c, from, "map_tier", err, len, "'%s' is not one of the tiers", t->map_tier);
+    if (m == t) return located(c, from, "map_tier", err, len, "'%s' is this tier itself", t->map_tier);
+    if (m->map_tier) return located(c, from, "map_tier", err, len, "'%s' has a map_tier of its own: one level only", t->map_tier);
+    int same = m->rpm_count == t->rpm_count;
+    for (unsigned k = 0; same && k < t->rpm_count; ++k) same = m->rpm[k] == t->rpm[k];
+    if (!same) return located(c, from, "map_tier", err, len, "'%s' must turn the same rpm list as this tier", t->map_tier);
+    if (t->max_evaluations < 1)
+        return located(c, from, "max_evaluations", err, len, "with a map_tier it bounds this tier's runs: give >= 1");
+    return 0;
+}
+
 static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
@@ -206,8 +222,6 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "seeds", err, len, "one seed gives no spread: use seeds >= 2 or set stiffness_tolerance");
     if (!(t->angle_sd_deg >= 0 && t->angle_sd_deg < 45))
         return located(c, from, "angle_sd_deg", err, len, "%g must be in [0, 45)", t->angle_sd_deg);
-    if (!(fabs(t->angle_offset_deg) < 45))
-        return located(c, from, "angle_offset_deg", err, len, "%g must be in (-45, 45)", t->angle_offset_deg);
     for (unsigned k = 0; k < t->rpm_count; ++k)
         if (!(t->rpm[k] > 0 && t->rpm[k] <= 1000)) return located(c, from, "rpm", err, len, "%g must be in (0, 1000]", t->rpm[k]);
     if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
@@ -219,7 +233,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         if (!(t->csa_sd_percent[k] >= 0 && t->csa_sd_percent[k] < 50))
             return located(c, from, "csa_sd_percent", err, len, "%g must be in [0, 50) percentage points",
                            t->csa_sd_percent[k]);
-    return 0;
+    return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
 }
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
@@ -326,12 +340,14 @@ cal_config *cal_config_load(const char *path, const char *tier_override, char *e
 
 void cal_config_free(cal_config *c) { exp_yaml_free(&config_schema, c); }
 
-const cal_tier *cal_config_tier(const cal_config *c)
+const cal_tier *cal_config_tier_named(const cal_config *c, const char *name)
 {
     for (unsigned k = 0; k < c->tiers_count; ++k)
-        if (strcmp(c->tiers[k].name, c->tier) == 0) return &c->tiers[k];
+        if (strcmp(c->tiers[k].name, name) == 0) return &c->tiers[k];
     return NULL;
 }
+
+const cal_tier *cal_config_tier(const cal_config *c) { return cal_config_tier_named(c, c->tier); }
 
 void cal_config_data_path(const cal_config *c, const char *rel, char *out, size_t len)
 {

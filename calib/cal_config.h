@@ -40,8 +40,6 @@ typedef struct cal_tier {
     int grid;               ///< initial design: grid points per axis of (μs, log μr)
     int max_evaluations;    ///< NLopt evaluations after the grid
     double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
-    double angle_offset_deg; ///< the tier's angle bias against the paper's fidelity (measured): the lab angle
-                             ///< plus this is the target in the tier's own scale; 0 = none
     /// How the angle enters the friction search: "constraint" (absent: the
     /// paper's rule, sections 4.2-4.3: the angle within its tolerance first,
     /// then the best CSA misfit) or "misfit" (the angle is one more
@@ -59,6 +57,11 @@ typedef struct cal_tier {
     /// After the search, the best μs with μr at each search bound, so that the
     /// identified μr range says whether the data bound it (absent: true).
     int *bound_probes;
+    /// A cheaper tier that maps the friction plane first (cal_multifidelity.h):
+    /// this tier then runs only where the map, corrected by the discrepancy it
+    /// measures between the two, puts the optimum; max_evaluations bounds
+    /// those runs and grid is unused. NULL: a one-tier search.
+    char *map_tier;
 } cal_tier;
 
 /// 1 if the tier puts the angle into the misfit instead of a constraint.
@@ -123,6 +126,8 @@ void cal_config_free(cal_config *c);
 
 /// The tier the config selects.
 const cal_tier *cal_config_tier(const cal_config *c);
+/// The tier named `name`, NULL if none.
+const cal_tier *cal_config_tier_named(const cal_config *c, const char *name);
 
 /// A data path resolved against the config file's directory.
 void cal_config_data_path(const cal_config *c, const char *rel, char *out, size_t len);

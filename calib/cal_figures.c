@@ -74,8 +74,7 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
     snprintf(path, sizeof path, "%s/angle_map_%s.png", dir, stage_name(r));
     snprintf(title, sizeof title, "%s: dynamic angle of repose at %g rpm (Fig. %s)", stage_name(r), r->angle_rpm,
              r->material[0] ? "17" : "13");
-    snprintf(band, sizeof band, "target angle %.1f° ± %.1f°%s", r->angle_target, r->angle_tolerance,
-             r->angle_offset != 0 ? " (lab + tier offset)" : " (lab)");
+    snprintf(band, sizeof band, "target angle %.1f° ± %.1f° (data)", r->angle_target, r->angle_tolerance);
     snprintf(evaluated, sizeof evaluated, "evaluated candidates (%d)", r->n);
     if (r->best >= 0)
         snprintf(chosen, sizeof chosen, "chosen: μs = %.3g, μr = %.3g", r->cand[r->best].mu_s, r->cand[r->best].mu_r);

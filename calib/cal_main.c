@@ -21,6 +21,8 @@ static const char main_help[] =
     "  measure PHOTO.png     angle of repose and occupied area of a drum photograph\n"
     "  study fidelity        what accuracy costs in time: the drum over a ladder of\n"
     "                        scale factors, depths and run lengths, error vs wall time\n"
+    "  synthesize [CONFIG]   drum data made by a tier's own drum at known pairs: the\n"
+    "                        data of a twin experiment (calibrate --data DIR)\n"
     "  --version             print the version\n"
     "\n"
     "Run `granucal COMMAND --help` for the options of a command.\n";
@@ -31,7 +33,7 @@ typedef struct command {
 } command;
 
 static const command commands[] = {{"simulate", cal_cmd_simulate}, {"measure", cal_cmd_measure}, {"calibrate", cal_cmd_calibrate},
-                                   {"study", cal_cmd_study}};
+                                   {"study", cal_cmd_study}, {"synthesize", cal_cmd_synthesize}};
 
 int main(int argc, char **argv)
 {

@@ -26,7 +26,7 @@ typedef struct row {
     cal_range range; ///< identified range of a calibrated friction; NAN otherwise
 } row;
 
-static const cal_range no_range = {NAN, NAN, NAN, NAN};
+static const cal_range no_range = CAL_NO_RANGE_INIT;
 
 static int table_rows(const cal_table *t, row *rows)
 {
@@ -56,19 +56,26 @@ static int write_table_csv(const char *dir, const row *rows, int n, char *err, s
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     // identified_min/max: the range of the candidates the data cannot tell
-    // apart (cal_friction_identify); empty where nothing was calibrated.
-    fputs("contact,material,parameter,value,unit,identified_min,identified_max\n", a.f);
+    // apart (cal_friction_identify); not_excluded_min/max: its bracket, the
+    // interval no evaluated candidate excludes (cal_range); empty where
+    // nothing was calibrated.
+    fputs("contact,material,parameter,value,unit,identified_min,identified_max,not_excluded_min,not_excluded_max\n", a.f);
     for (int i = 0; i < n; ++i) {
+        const cal_range *g = &rows[i].range;
         fprintf(a.f, "%s,%s,%s,%.6g,%s,", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
-        if (isfinite(rows[i].range.lo)) fprintf(a.f, "%.6g,%.6g\n", rows[i].range.lo, rows[i].range.hi);
+        if (isfinite(g->lo)) fprintf(a.f, "%.6g,%.6g,", g->lo, g->hi);
+        else fputs(",,", a.f);
+        if (isfinite(g->bracket_lo)) fprintf(a.f, "%.6g,%.6g\n", g->bracket_lo, g->bracket_hi);
         else fputs(",\n", a.f);
     }
     return cal_atomic_commit(&a, err, len);
 }
 
-static const char *range_cell(char out[48], cal_range g)
+static const char *range_cell(char out[96], cal_range g)
 {
-    if (isfinite(g.lo)) snprintf(out, 48, "%.3g – %.3g", g.lo, g.hi);
+    if (isfinite(g.lo) && isfinite(g.bracket_lo))
+        snprintf(out, 96, "%.3g – %.3g (not excluded: %.3g – %.3g)", g.lo, g.hi, g.bracket_lo, g.bracket_hi);
+    else if (isfinite(g.lo)) snprintf(out, 96, "%.3g – %.3g", g.lo, g.hi);
     else out[0] = '\0';
     return out;
 }
@@ -80,7 +87,7 @@ static int write_table_md(const char *dir, const cal_table *t, char *err, size_t
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
-    char g[2][48];
+    char g[2][96];
     fputs("| Contact | Parameter | Material | Value | Identified range (95 %) | Source |\n|---|---|---|---|---|---|\n", f);
     fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | | config |\n", t->density);
     fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | | %s |\n", t->k_n, t->k_source);
@@ -391,18 +398,32 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     report_range(f, "μr", r->mu_r_range, b->mu_r_min, b->mu_r_max);
 }
 
+// A two-tier stage: what the map tier cost, what this tier's runs measured
+// against it, and how the loop ended.
+static void report_two_tier(FILE *f, const cal_friction_result *r)
+{
+    int predicted = 0;
+    for (int i = 0; i < r->n; ++i) predicted += r->cand[i].predicted;
+    fprintf(f, "Two tiers: tier '%s' mapped the plane (%d candidates, %.0f s); this tier ran %d candidate(s) where the "
+               "corrected map put the optimum (%.0f s with the map). Outcome: %s. The correction measured between the "
+               "tiers (this tier minus the map): angle %+.2f°",
+            r->map_tier, r->map_candidates, r->map_wall_time_s, r->expensive_candidates, r->wall_time_s,
+            r->two_tier_outcome ? r->two_tier_outcome : "not run", r->correction[0]);
+    for (int j = 0; j < r->n_rpm; ++j) fprintf(f, ", CSA at %g rpm %+.2f points", r->rpm[j], r->correction[1 + j]);
+    fprintf(f, ". The %d candidates marked \"map + correction\" below are the map tier's runs plus that correction, "
+               "not runs of this tier: they enter the identified ranges, never the choice.\n\n", predicted);
+}
+
 static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds)
 {
     const char *stage = r->material[0] ? r->material : "granule-granule";
     fprintf(f, "\n## %s (surface '%s' in the data)\n\n", stage, r->surface);
     if (r->material[0]) fprintf(f, "Granule–granule frozen at μs = %.4g, μr = %.4g. ", r->frozen_mu_s, r->frozen_mu_r);
     fprintf(f, "Target angle %.2f° at %g rpm", r->angle_target, r->angle_rpm);
-    if (r->angle_offset != 0)
-        fprintf(f, " (the lab's %.2f° plus this tier's measured offset %+.2f°: its coarse granules pile steeper)",
-                r->angle_lab, r->angle_offset);
-    fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. NLopt COBYLA: "
-               "%s. %d candidates, %.0f s.\n\n",
-            r->angle_tolerance, r->n_rpm, r->nlopt_result, r->n, r->wall_time_s);
+    fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. ", r->angle_tolerance,
+            r->n_rpm);
+    if (r->map_tier[0]) report_two_tier(f, r);
+    else fprintf(f, "NLopt COBYLA: %s. %d candidates, %.0f s.\n\n", r->nlopt_result, r->n, r->wall_time_s);
     if (r->angle_in_misfit)
         fputs("Rule (`angle_rule: misfit`): the angle is one more measurement in the misfit, its z-score taken against "
               "the tolerance, averaged with the CSA speeds' squared z-scores; the tier's angle noise is as wide as the "

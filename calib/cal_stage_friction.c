@@ -37,7 +37,7 @@ static const double min_csa_sd = 0.1;
 /// Likewise the angle's tolerance where it is a term of the misfit (°).
 static const double min_angle_sd = 0.1;
 
-typedef struct search {
+typedef struct cal_friction_search {
     cal_env *env;
     const cal_config *c;
     const cal_tier *t;
@@ -57,6 +57,17 @@ static double to_mu_r(const cal_bounds *b, double v)
 {
     return pow(10, log10(b->mu_r_min) + v * (log10(b->mu_r_max) - log10(b->mu_r_min)));
 }
+
+void cal_friction_to_mu(const cal_bounds *b, double u, double v, double *mu_s, double *mu_r)
+{
+    *mu_s = to_mu_s(b, u), *mu_r = to_mu_r(b, v);
+}
+
+void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double *u, double *v)
+{
+    *u = (mu_s - b->mu_s_min) / (b->mu_s_max - b->mu_s_min);
+    *v = (log10(mu_r) - log10(b->mu_r_min)) / (log10(b->mu_r_max) - log10(b->mu_r_min));
+}
 static const cal_bounds *bounds_of(const search *s) { return s->material ? &s->c->wall : &s->c->granule; }
 
 // A measurement's squared z-score, or the penalty where it failed.
@@ -72,11 +83,19 @@ static double angle_z2(const cal_friction_result *r, const cal_candidate *k)
     return squared_z(k->angle_deg, r->angle_target, fmax(r->angle_tolerance, min_angle_sd), 1);
 }
 
-// Speed i's CSA squared z-score; tier_sd: the tier's spread added in quadrature (0: the lab's alone).
-static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
+// Speed i's CSA spread: the lab's (floored), and the tier's added in quadrature (tier_sd 0: the lab's alone).
+static double csa_spread(const cal_friction_result *r, int i, double tier_sd)
 {
     double lab = fmax(r->csa_data_sd[i], min_csa_sd);
-    return squared_z(k->csa[i], r->csa_data[i], sqrt(lab * lab + tier_sd * tier_sd), k->usable[i]);
+    return sqrt(lab * lab + tier_sd * tier_sd);
+}
+
+double cal_friction_csa_spread(const cal_friction_result *r, int i) { return csa_spread(r, i, r->csa_tier_sd[i]); }
+
+// Speed i's CSA squared z-score against csa_spread.
+static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
+{
+    return squared_z(k->csa[i], r->csa_data[i], csa_spread(r, i, tier_sd), k->usable[i]);
 }
 
 void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
@@ -106,7 +125,11 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
 }
 
 // Candidates the stage evaluates at most: the grid, COBYLA's, the bound probes.
-static int planned_candidates(const cal_tier *t) { return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0); }
+static int planned_candidates(const cal_tier *t)
+{
+    if (t->map_tier) return t->max_evaluations; // the two-tier loop's budget (its map tier plans its own)
+    return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0);
+}
 
 // "candidate i of at most N" (or "candidates i-j"), with the time left at the pace so far.
 static void show_start(const search *s, const double (*mu)[2], int m)
@@ -226,7 +249,8 @@ int cal_friction_best(const cal_friction_result *r)
 {
     int best = -1;
     for (int i = 0; i < r->n; ++i)
-        if (isfinite(r->cand[i].angle_deg) && (best < 0 || better(r, &r->cand[i], &r->cand[best]))) best = i;
+        if (!r->cand[i].predicted && isfinite(r->cand[i].angle_deg) && (best < 0 || better(r, &r->cand[i], &r->cand[best])))
+            best = i;
     return best;
 }
 
@@ -246,13 +270,13 @@ static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 // excluded value beyond each end.
 static cal_range range_of(const cal_friction_result *r, int rolling)
 {
-    cal_range g = {INFINITY, -INFINITY, NAN, NAN};
+    cal_range g = {INFINITY, -INFINITY, NAN, NAN, NAN, NAN};
     for (int i = 0; i < r->n; ++i)
         if (r->cand[i].identified) {
             double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
             g.lo = fmin(g.lo, v), g.hi = fmax(g.hi, v);
         }
-    if (!(g.lo <= g.hi)) return (cal_range){NAN, NAN, NAN, NAN};
+    if (!(g.lo <= g.hi)) return CAL_NO_RANGE;
     for (int i = 0; i < r->n; ++i) {
         double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
         if (r->cand[i].identified) continue;
@@ -260,6 +284,13 @@ static cal_range range_of(const cal_friction_result *r, int rolling)
         if (v > g.hi && !(v >= g.above)) g.above = v; // the smallest above
     }
     return g;
+}
+
+void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi)
+{
+    if (!isfinite(g->lo)) return;
+    g->bracket_lo = isfinite(g->below) ? g->below : bound_lo;
+    g->bracket_hi = isfinite(g->above) ? g->above : bound_hi;
 }
 
 void cal_friction_identify(cal_friction_result *r)
@@ -276,12 +307,6 @@ void cal_friction_identify(cal_friction_result *r)
     r->mu_s_range = range_of(r, 0), r->mu_r_range = range_of(r, 1);
 }
 
-static void unit_coordinates(const search *s, const cal_candidate *k, double *u, double *v)
-{
-    const cal_bounds *b = bounds_of(s);
-    *u = (k->mu_s - b->mu_s_min) / (b->mu_s_max - b->mu_s_min);
-    *v = (log10(k->mu_r) - log10(b->mu_r_min)) / (log10(b->mu_r_max) - log10(b->mu_r_min));
-}
 
 static const char *run_cobyla(search *s)
 {
@@ -291,7 +316,7 @@ static const char *run_cobyla(search *s)
     double lo[2] = {0, 0}, hi[2] = {1, 1}, x[2] = {0.5, 0.5}, fx;
     double step = s->t->grid > 1 ? 0.5 / s->t->grid : 0.25;
     double dx[2] = {step, step};
-    if (start >= 0) unit_coordinates(s, &s->r->cand[start], &x[0], &x[1]);
+    if (start >= 0) cal_friction_to_unit(bounds_of(s), s->r->cand[start].mu_s, s->r->cand[start].mu_r, &x[0], &x[1]);
     nlopt_set_lower_bounds(opt, lo), nlopt_set_upper_bounds(opt, hi);
     nlopt_set_min_objective(opt, objective, s);
     if (!s->r->angle_in_misfit) nlopt_add_inequality_constraint(opt, angle_constraint, s, 0.0);
@@ -350,11 +375,10 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     const cal_point *pts[64];
     size_t n = cal_series_select(angles, r->surface, pts, 64);
     if (n == 0) return exp_fail(s->err, s->len, "%s: no angle of repose for surface '%s'", angles->path, r->surface);
-    // A coarse tier measures a biased angle (the angle grows with the scale
-    // factor, Table B.1); its measured offset moves the lab's target onto the
-    // tier's own scale (cal_tier.angle_offset_deg, docs/calibration.md, "Table 3 in CI").
-    r->angle_lab = pts[0]->value, r->angle_offset = s->t->angle_offset_deg;
-    r->angle_target = r->angle_lab + r->angle_offset, r->angle_rpm = pts[0]->rpm;
+    // The data's angle as it is: a coarse tier's bias against the lab (its
+    // granules pile steeper, Table B.1) is not corrected here by a number
+    // measured at any known answer; the tier's table is the tier's.
+    r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
     r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + s->t->angle_sd_deg * s->t->angle_sd_deg);
     n = cal_series_select(areas, r->surface, pts, 64);
     if (n == 0) return exp_fail(s->err, s->len, "%s: no occupied area for surface '%s'", areas->path, r->surface);
@@ -386,31 +410,63 @@ int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_
     search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = sizeof err};
     int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t);
     free(r);
-    return runs;
+    const cal_tier *map = t->map_tier ? cal_config_tier_named(c, t->map_tier) : NULL;
+    int map_runs = map && runs >= 0 ? cal_friction_planned_runs(c, map, angles, areas, material) : 0;
+    return map_runs < 0 ? -1 : runs + map_runs;
+}
+
+// The stage's search with its targets set: what a one-tier stage and the
+// two-tier stage (cal_stage_two_tier.c) both start from.
+cal_friction_search *cal_friction_begin(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                                        const cal_series *areas, double k_n, const cal_material *material,
+                                        double gg_mu_s, double gg_mu_r, cal_friction_result *out, char *err, size_t len)
+{
+    memset(out, 0, sizeof *out);
+    snprintf(out->material, sizeof out->material, "%s", material ? material->name : "");
+    snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
+    out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
+    out->angle_in_misfit = cal_tier_angle_in_misfit(t);
+    search *s = calloc(1, sizeof *s);
+    if (!s) return exp_fail(err, len, "out of memory"), NULL;
+    *s = (search){.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len,
+                  .started = exp_wall_seconds()};
+    if (set_targets(s, angles, areas)) return free(s), NULL;
+    return s;
+}
+
+cal_candidate *cal_friction_evaluate(cal_friction_search *s, double mu_s, double mu_r, const char *origin)
+{
+    return s->failed ? NULL : evaluate(s, mu_s, mu_r, origin);
+}
+
+const cal_bounds *cal_friction_bounds(const cal_friction_search *s) { return bounds_of(s); }
+
+int cal_friction_finish(cal_friction_search *s)
+{
+    cal_friction_result *out = s->r;
+    out->best = cal_friction_best(out);
+    cal_friction_identify(out);
+    const cal_bounds *b = bounds_of(s);
+    cal_range_bracket(&out->mu_s_range, b->mu_s_min, b->mu_s_max);
+    cal_range_bracket(&out->mu_r_range, b->mu_r_min, b->mu_r_max);
+    out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
+    out->wall_time_s = exp_wall_seconds() - s->started;
+    int failed = s->failed;
+    if (!failed && out->best < 0) failed = exp_fail(s->err, s->len, "%s: every candidate failed; see simulations.csv", s->env->stage);
+    free(s);
+    return failed != 0;
 }
 
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, char *err, size_t len)
 {
-    memset(out, 0, sizeof *out);
-    double t0 = exp_wall_seconds();
-    snprintf(out->material, sizeof out->material, "%s", material ? material->name : "");
-    snprintf(out->surface, sizeof out->surface, "%s", material ? material->surface : c->granule_surface);
-    out->k_n = k_n, out->frozen_mu_s = gg_mu_s, out->frozen_mu_r = gg_mu_r;
-    out->angle_in_misfit = cal_tier_angle_in_misfit(t);
     cal_env_set_stage(env, material ? material->name : "granule");
     cal_progress_enter(env->progress, env->stage);
-    search s = {.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len, .started = t0};
-    if (set_targets(&s, angles, areas)) return 1;
-    evaluate_grid(&s);
-    out->nlopt_result = s.failed ? "not run" : run_cobyla(&s);
-    if (cal_tier_bound_probes(t)) probe_bounds(&s);
-    out->best = cal_friction_best(out);
-    cal_friction_identify(out);
-    out->best_feasible = out->best >= 0 && out->cand[out->best].angle_violation <= 0;
-    out->wall_time_s = exp_wall_seconds() - t0;
-    if (s.failed) return 1;
-    if (out->best < 0) return exp_fail(err, len, "%s: every candidate failed; see simulations.csv", env->stage);
-    return 0;
+    search *s = cal_friction_begin(env, c, t, angles, areas, k_n, material, gg_mu_s, gg_mu_r, out, err, len);
+    if (!s) return 1;
+    evaluate_grid(s);
+    out->nlopt_result = s->failed ? "not run" : run_cobyla(s);
+    if (cal_tier_bound_probes(t)) probe_bounds(s);
+    return cal_friction_finish(s);
 }

@@ -46,17 +46,33 @@ typedef struct cal_candidate {
     double angle_violation;             ///< |angle - target| - tolerance (≤ 0: matches)
     double objective;                   ///< what the search minimises: the CSA misfit, or with the
                                         ///< angle's squared z-score as one more term (angle_in_misfit)
-    const char *origin;                 ///< "grid", "COBYLA" or "bound probe"
+    const char *origin;                 ///< "grid", "COBYLA", "bound probe", "two-tier" or "map + correction"
+    int predicted;                      ///< 1: not run at this tier but the corrected cheap map's value
+                                        ///< at a cheap candidate (two-tier stage): in the identified
+                                        ///< range, never the chosen pair
     double chi2;                        ///< χ² against the data with the lab's and the tier's spreads (identification)
     int identified;                     ///< 1 if the data cannot tell it from the best χ² (Δχ² within the threshold)
     double wall_time_s;
 } cal_candidate;
 
 /// The range of one parameter over the candidates the data cannot tell apart.
+/// The candidates are a sparse set, so [lo, hi] alone can be narrower than
+/// what the data say (one μs value identified says nothing of the gap to the
+/// nearest excluded one): the bracket is the interval no evaluated candidate
+/// excludes, from the nearest excluded value beyond each end, or the search
+/// bound where nothing beyond was excluded.
 typedef struct cal_range {
     double lo, hi;       ///< smallest and largest value among them
     double below, above; ///< the nearest excluded candidate's value beyond each end; NAN: none evaluated there
+    double bracket_lo, bracket_hi; ///< below/above, or the search bound where NAN (cal_range_bracket)
 } cal_range;
+
+/// No range (the stage was not run).
+#define CAL_NO_RANGE_INIT {NAN, NAN, NAN, NAN, NAN, NAN}
+#define CAL_NO_RANGE ((cal_range)CAL_NO_RANGE_INIT)
+
+/// Set g's bracket from below/above and the search bounds.
+void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi);
 
 /// What a friction stage found.
 typedef struct cal_friction_result {
@@ -64,8 +80,7 @@ typedef struct cal_friction_result {
     char surface[64];
     double k_n;
     double frozen_mu_s, frozen_mu_r;    ///< granule–granule pair (wall stage)
-    double angle_target, angle_tolerance, angle_rpm; ///< target in the tier's scale: lab + offset
-    double angle_lab, angle_offset;                  ///< the lab's angle and the tier's offset
+    double angle_target, angle_tolerance, angle_rpm; ///< the data's angle, its tolerance (data and tier spreads)
     int angle_in_misfit;                             ///< the tier's angle_rule is "misfit"
     int n_rpm;
     double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
@@ -80,6 +95,15 @@ typedef struct cal_friction_result {
     int identified_count;               ///< candidates within the threshold
     const char *nlopt_result;
     double wall_time_s;
+    /// Two-tier stage (tier with map_tier): the cheap tier, its runs and
+    /// cost, the correction measured (angle, then CSA per speed), and how the
+    /// loop ended. map_tier[0] == 0: a one-tier stage.
+    char map_tier[32];
+    int map_candidates, expensive_candidates;
+    double map_wall_time_s;
+    double correction[CAL_MAX_RPM + 1];
+    double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
+    const char *two_tier_outcome;
 } cal_friction_result;
 
 /// A candidate's scores from its measurements (angle_deg, csa, usable):
@@ -104,9 +128,40 @@ void cal_friction_identify(cal_friction_result *r);
 int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
                               const cal_series *areas, const cal_material *material);
 
-/// Stage 2 (material == NULL) or 3 (a material of the config).
+/// A friction search in progress (targets set from the data, candidates so far).
+typedef struct cal_friction_search cal_friction_search;
+
+/// Start a stage's search: out's targets and tolerances from the data; NULL
+/// and a message if the data lack them.
+cal_friction_search *cal_friction_begin(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                                        const cal_series *areas, double k_n, const cal_material *material,
+                                        double gg_mu_s, double gg_mu_r, cal_friction_result *out, char *err, size_t len);
+/// Run (or find) the candidate at (mu_s, mu_r); NULL when the store failed.
+cal_candidate *cal_friction_evaluate(cal_friction_search *s, double mu_s, double mu_r, const char *origin);
+/// The search's bounds (granule or wall).
+const cal_bounds *cal_friction_bounds(const cal_friction_search *s);
+/// Choose the best, identify the ranges, free the search; 1 with the message
+/// if a simulation could not be stored or every candidate failed.
+int cal_friction_finish(cal_friction_search *s);
+
+/// Stage 2 (material == NULL) or 3 (a material of the config), one tier.
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, char *err, size_t len);
+
+/// The unit square's (u, v) as (μs, log μr) within bounds b, and back.
+void cal_friction_to_mu(const cal_bounds *b, double u, double v, double *mu_s, double *mu_r);
+void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double *u, double *v);
+/// Speed i's CSA spread in the χ² and the misfit: the lab's (floored) and the
+/// tier's in quadrature.
+double cal_friction_csa_spread(const cal_friction_result *r, int i);
+
+/// The same stage across two tiers (the tier's map_tier maps, the tier itself
+/// decides; cal_multifidelity.h): the cheap tier's whole search first (its
+/// candidates in cheap_out), then the tier's own runs where the corrected map
+/// puts the optimum.
+int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                       const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
+                       double gg_mu_r, cal_friction_result *out, cal_friction_result *cheap_out, char *err, size_t len);
 
 #endif

@@ -46,6 +46,8 @@ static const char help[] =
     "  --budget-hours H     replaces fidelity.budget_hours\n"
     "  --seeds N            replaces fidelity.seeds (1-16)\n"
     "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
+    "  --rpm A,B,...        only these of fidelity.rpm (e.g. --rpm 4 to narrow the\n"
+    "                       4 rpm angle's error first; default: every speed)\n"
     "  --jobs N             simulations side by side (default: cores)\n"
     "  --checkpoint-every S wall seconds between a drum run's checkpoints (default 120;\n"
     "                       0: none); a killed study, run again, resumes each turn\n"
@@ -63,7 +65,7 @@ static const struct {
 } table_b1[] = {{8, 33.4, 43.9}, {27, 33.9, 44.5}, {64, 34.6, 45.5}};
 
 typedef struct options {
-    const char *config, *out, *rungs;
+    const char *config, *out, *rungs, *rpm; ///< rungs, rpm: comma lists (NULL: all)
     double budget_hours, checkpoint_every_s;
     int jobs, seeds; ///< seeds 0: the config's
 } options;
@@ -98,7 +100,8 @@ static int parse_options(int argc, char **argv, options *o)
     static const struct option longs[] = {{"out", required_argument, 0, 'o'}, {"budget-hours", required_argument, 0, 'b'},
                                           {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
                                           {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
-                                          {"checkpoint-every", required_argument, 0, 'c'}, {0, 0, 0, 0}};
+                                          {"checkpoint-every", required_argument, 0, 'c'}, {"rpm", required_argument, 0, 'm'},
+                                          {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     optind = 1;
@@ -107,6 +110,7 @@ static int parse_options(int argc, char **argv, options *o)
         switch (ch) {
         case 'o': o->out = optarg; break;
         case 'r': o->rungs = optarg; break;
+        case 'm': o->rpm = optarg; break;
         case 'b':
             if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
                 return fprintf(stderr, "granucal study: --budget-hours '%s': need a number > 0\n", optarg), 2;
@@ -141,6 +145,30 @@ static int wanted(const char *list, const char *name)
     for (const char *p = list; (p = strstr(p, name)); p += n)
         if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == 0)) return 1;
     return 0;
+}
+
+/// Keeps only the speeds of `list` (comma-separated rpm) in the ladder's
+/// speeds, in the config's order; a speed the ladder does not have is refused
+/// (a study of a speed nobody configured would have no store to share).
+static int narrow_speeds(cal_fidelity *f, const char *list, const char *path, char *err, size_t len)
+{
+    unsigned keep[MAX_SPEEDS] = {0};
+    char copy[512];
+    snprintf(copy, sizeof copy, "%s", list);
+    for (char *save = NULL, *t = strtok_r(copy, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        double v;
+        if (exp_parse_number(t, &v)) return exp_fail(err, len, "--rpm '%s': '%s' is not a number", list, t);
+        unsigned k = 0;
+        while (k < f->rpm_count && f->rpm[k] != v) ++k;
+        if (k == f->rpm_count || k >= MAX_SPEEDS)
+            return exp_fail(err, len, "--rpm %g: not one of fidelity.rpm in %s", v, path);
+        keep[k] = 1;
+    }
+    unsigned n = 0;
+    for (unsigned k = 0; k < f->rpm_count; ++k)
+        if (keep[k]) f->rpm[n++] = f->rpm[k];
+    f->rpm_count = n;
+    return n ? 0 : exp_fail(err, len, "--rpm '%s': no speed given", list);
 }
 
 /// The rung as a calibration tier (the drum case takes one).
@@ -567,6 +595,7 @@ int cal_cmd_study(int argc, char **argv)
     if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
     else if (!s->c) status = 1;
     if (!status && s->opt.seeds) s->c->fidelity->seeds = s->opt.seeds;
+    if (!status && s->opt.rpm) status = narrow_speeds(s->c->fidelity, s->opt.rpm, s->c->path, s->err, sizeof s->err);
     if (!status) {
         snprintf(s->out, sizeof s->out, "%s", s->opt.out);
         status = cal_prepare_output(s->out, s->err, sizeof s->err);

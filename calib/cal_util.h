@@ -40,5 +40,8 @@ void cal_atomic_abort(cal_atomic_file *a);
 /// Returns how many were removed.
 int cal_atomic_sweep(const char *dir);
 
+/// The commit the binary was built from ("git describe --dirty" at build
+/// time), for the provenance line of files a run writes.
+const char *cal_build_commit(void);
 
 #endif

@@ -74,7 +74,6 @@ static void check_config(const cal_config *c, const char *path)
         finite(L, "tier steady_csa_tol_percent", t->steady_csa_tol_percent);
         known_fill(t->fill_method, t->average_time, t->window, t->max_time);
         for (unsigned j = 0; j < t->rpm_count; ++j) finite(L, "tier rpm", t->rpm[j]);
-        finite(L, "tier angle_offset_deg", t->angle_offset_deg);
         if (t->angle_rule && strcmp(t->angle_rule, "constraint") != 0 && strcmp(t->angle_rule, "misfit") != 0)
             fuzz_violation("cal_config_load accepted an unknown angle_rule", t->angle_rule);
         if (t->csa_sd_percent_count > 1 && t->csa_sd_percent_count != t->rpm_count)

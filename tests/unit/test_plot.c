@@ -152,7 +152,7 @@ static void friction_stage(cal_friction_result *r, int n_rpm)
 {
     memset(r, 0, sizeof *r);
     snprintf(r->material, sizeof r->material, "PTFE");
-    r->angle_target = 36, r->angle_tolerance = 1.5, r->angle_rpm = 4, r->angle_lab = 36;
+    r->angle_target = 36, r->angle_tolerance = 1.5, r->angle_rpm = 4;
     r->n_rpm = n_rpm;
     for (int j = 0; j < n_rpm; ++j) r->rpm[j] = 4 + 40 * j, r->csa_data[j] = 44 + j, r->csa_data_sd[j] = 0.5;
     double pts[][2] = {{0.25, 0.003}, {0.25, 0.03}, {0.25, 0.3}, {0.5, 0.003}, {0.5, 0.03}, {0.5, 0.3}, {0.75, 0.003},

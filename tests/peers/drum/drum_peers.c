@@ -49,7 +49,7 @@ static int collect_sets(int argc, char **argv, int from, char **sets)
     return n;
 }
 
-static const cal_range no_range = {NAN, NAN, NAN, NAN};
+static const cal_range no_range = CAL_NO_RANGE_INIT;
 
 // One row of calibrated_parameters.csv into the table (the ranges are the
 // report's business, not the export's: left out).

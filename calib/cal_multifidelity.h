@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_multifidelity.h
+/// A friction search across two fidelities. A cheap tier maps the response
+/// (the angle and the CSA at each speed) over the unit square of (μs, log μr);
+/// a quadratic least-squares surface through those points is the map. The
+/// expensive (converged) tier is run only where the map says the optimum is,
+/// and at each such point the program measures the discrepancy between the
+/// two tiers; the map, corrected by the mean discrepancy so far (one additive
+/// correction per measurement), gives the next optimum. The search ends when
+/// an expensive run agrees with what the corrected map predicted for it
+/// within the data's noise, or its budget of expensive runs is spent.
+///
+/// Nothing here knows about drums: the stage gives the objective of a
+/// measurement vector and a function that runs the expensive tier, so the
+/// loop is tested on analytic responses (tests/unit/test_multifidelity.c).
+#ifndef CAL_MULTIFIDELITY_H
+#define CAL_MULTIFIDELITY_H
+
+enum { CAL_MF_MAX_Y = 17, CAL_MF_MAX_FINE = 64, CAL_MF_TERMS = 6 };
+
+/// Measurements at one point of the unit square (u: μs, v: log μr).
+typedef struct cal_mf_point {
+    double u, v;
+    double y[CAL_MF_MAX_Y]; ///< angle first, then the CSA at each speed
+} cal_mf_point;
+
+/// The map: per measurement, coefficients of 1, u, v, u², uv, v² (the last
+/// three 0 where too few points for a quadratic), and its rms residual.
+typedef struct cal_mf_map {
+    int n_y, n_terms;
+    double coef[CAL_MF_MAX_Y][CAL_MF_TERMS];
+    double rms[CAL_MF_MAX_Y];
+} cal_mf_map;
+
+/// Least squares through n points: quadratic with n >= 8 (two points per
+/// coefficient beyond the linear ones), linear with n >= 3; 1 (and nothing
+/// fitted) with fewer or a singular design.
+int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map);
+
+/// The map at (u, v) plus `delta` (NULL: none).
+void cal_mf_predict(const cal_mf_map *map, const double *delta, double u, double v, double *y);
+
+/// What the stage gives the loop.
+typedef struct cal_mf_problem {
+    int n_y;
+    /// What the search minimises, of a (predicted or measured) measurement vector.
+    double (*objective)(const double *y, void *ctx);
+    /// Run the expensive tier at (u, v): y filled, 0 (a measurement it could
+    /// not make: NAN, and the run neither agrees nor enters the correction);
+    /// nonzero when the run could not be done at all (the loop stops).
+    int (*run_expensive)(double u, double v, double *y, void *ctx);
+    const double *noise; ///< per measurement: how far a run may be from the prediction and agree
+    int max_expensive;   ///< budget of expensive runs (≤ CAL_MF_MAX_FINE)
+    void *ctx;
+} cal_mf_problem;
+
+typedef struct cal_mf_result {
+    int n;                                   ///< expensive runs made
+    cal_mf_point run[CAL_MF_MAX_FINE];       ///< where, and what they measured
+    double predicted[CAL_MF_MAX_FINE][CAL_MF_MAX_Y]; ///< what the corrected map said before each run
+    double delta[CAL_MF_MAX_Y];              ///< the correction after the last run (mean discrepancy)
+    int agreed;                              ///< 1: the last run agreed with its prediction
+    int settled;                             ///< 1: the next optimum was a point already run (stopped there)
+    int failed;                              ///< 1: an expensive run failed
+    double u_uncorrected, v_uncorrected;     ///< the cheap map's own optimum
+} cal_mf_result;
+
+/// The loop above; it also stops when the corrected optimum lands within 0.01
+/// of a point already run (a deterministic run there would repeat itself).
+/// Returns 0; out->failed says whether a run failed.
+int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out);
+
+/// The corrected map's optimum over the unit square (a 41 × 41 scan, then
+/// NLopt BOBYQA from its best point).
+void cal_mf_optimum(const cal_mf_map *map, const double *delta, const cal_mf_problem *p, double *u, double *v);
+
+#endif

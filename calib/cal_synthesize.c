@@ -1,0 +1,365 @@
+// SPDX-License-Identifier: MIT
+// `granucal synthesize`: drum data made by a tier's own drum at known pairs.
+// A twin experiment calibrates on them: the truth is known, so whether the
+// pipeline finds it (inside the range it says it identifies) is a test of the
+// pipeline at that tier, with no bias of the tier against the lab to correct.
+// The runs are the calibration's own drum cases (cal_drum_case_granule,
+// cal_drum_case_wall) on seeds the calibration does not use, so the data
+// differ from any candidate's run by the tier's seed noise, as lab data
+// differ from the model by the powder's.
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "cal_commands.h"
+#include "cal_data.h"
+#include "cal_mpi.h"
+#include "cal_sim.h"
+#include "cal_util.h"
+#include "exp_common.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+enum { MAX_SEEDS = 16, MAX_WALLS = 16, MAX_SPEEDS = 32 };
+
+static const char help[] =
+    "usage: granucal synthesize [CONFIG.yaml] [options]\n"
+    "\n"
+    "Makes the two data files a calibration reads (repose_angle.csv, occupied_area.csv)\n"
+    "from the config's own drum at known friction pairs: the drum lined with granules at\n"
+    "the granule-granule pair, and each wall material of the config at its pair (the\n"
+    "granule pair frozen), at the tier's speeds and the angle's speed, each the mean over\n"
+    "several beds (seeds) that the calibration itself does not use.\n"
+    "\n"
+    "A twin experiment: `granucal calibrate --data DIR` on these files must recover the\n"
+    "pairs inside the ranges it reports; what it cannot recover, the tier cannot identify.\n"
+    "The files say SYNTHETIC in their header with the command, version and seeds.\n"
+    "\n"
+    "options:\n"
+    "  --tier NAME           fidelity tier whose drum is run (default: the config's)\n"
+    "  --granule MU_S,MU_R   granule-granule pair (default: granule_mu_s, granule_mu_r)\n"
+    "  --wall NAME=MU_S,MU_R a wall material's pair, one option per material; a config\n"
+    "                        material without one is refused (its data would be missing)\n"
+    "  --k-n K               granule stiffness, N/m (default: the config's k_n)\n"
+    "  --seeds A,B,...       drum seeds (default 101,102,103; the config's seed, which the\n"
+    "                        calibration's candidates use, is refused)\n"
+    "  --out DIR             (default results/synthetic-<tier>); runs kept in DIR/store\n"
+    "  --jobs N              simulations side by side (default: cores)\n"
+    "  -h, --help            this text\n"
+    "\n"
+    "Each value is the mean over the seeds whose run is usable; its spread column is the\n"
+    "standard error of that mean (sd over seeds / sqrt(n)), floored at 0.05.\n";
+
+typedef struct pair {
+    char name[32];
+    double mu_s, mu_r;
+} pair;
+
+typedef struct options {
+    const char *config, *tier, *out;
+    pair granule, walls[MAX_WALLS];
+    int n_walls, has_granule, jobs, n_seeds;
+    double k_n; ///< NAN: the config's
+    long seeds[MAX_SEEDS];
+} options;
+
+static int parse_pair(const char *text, double *mu_s, double *mu_r)
+{
+    char *end;
+    *mu_s = strtod(text, &end);
+    if (end == text || *end != ',') return 1;
+    const char *second = end + 1;
+    *mu_r = strtod(second, &end);
+    return end == second || *end || !(*mu_s > 0) || !(*mu_r > 0) || !isfinite(*mu_s) || !isfinite(*mu_r);
+}
+
+static int parse_seeds(const char *text, options *o)
+{
+    char copy[256];
+    snprintf(copy, sizeof copy, "%s", text);
+    o->n_seeds = 0;
+    for (char *save = NULL, *t = strtok_r(copy, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        double v;
+        if (o->n_seeds == MAX_SEEDS || exp_parse_number(t, &v) || !exp_integer_in(v, 0, 1e9)) return 1;
+        o->seeds[o->n_seeds++] = (long)v;
+    }
+    return o->n_seeds == 0;
+}
+
+static int bad_option(const char *name, const char *value, const char *want)
+{
+    fprintf(stderr, "granucal synthesize: %s '%s': %s\n", name, value, want);
+    return 2;
+}
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    static const struct option longs[] = {{"tier", 1, 0, 't'},  {"granule", 1, 0, 'g'}, {"wall", 1, 0, 'w'},
+                                          {"k-n", 1, 0, 'k'},   {"seeds", 1, 0, 's'},   {"out", 1, 0, 'o'},
+                                          {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},    {0, 0, 0, 0}};
+    *o = (options){.config = "configs/calibration.yaml", .k_n = NAN, .n_seeds = 3, .seeds = {101, 102, 103},
+                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
+    optind = 1;
+    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+        double v;
+        switch (ch) {
+        case 't': o->tier = optarg; break;
+        case 'o': o->out = optarg; break;
+        case 'g':
+            if (parse_pair(optarg, &o->granule.mu_s, &o->granule.mu_r))
+                return bad_option("--granule", optarg, "need MU_S,MU_R, both > 0");
+            o->has_granule = 1;
+            break;
+        case 'w': {
+            const char *eq = strchr(optarg, '=');
+            pair *p = &o->walls[o->n_walls];
+            if (o->n_walls == MAX_WALLS || !eq || eq == optarg || (size_t)(eq - optarg) >= sizeof p->name ||
+                parse_pair(eq + 1, &p->mu_s, &p->mu_r))
+                return bad_option("--wall", optarg, "need NAME=MU_S,MU_R, both > 0");
+            snprintf(p->name, sizeof p->name, "%.*s", (int)(eq - optarg), optarg);
+            o->n_walls++;
+            break;
+        }
+        case 'k':
+            if (exp_parse_number(optarg, &o->k_n) || !(o->k_n > 0)) return bad_option("--k-n", optarg, "need a stiffness > 0 N/m");
+            break;
+        case 's':
+            if (parse_seeds(optarg, o)) return bad_option("--seeds", optarg, "need 1-16 whole numbers separated by commas");
+            break;
+        case 'j':
+            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024)) return bad_option("--jobs", optarg, "need 1..1024");
+            o->jobs = (int)v;
+            break;
+        case 'h': fputs(help, stdout); return -1;
+        default: fputs(help, stderr); return 2;
+        }
+    }
+    if (optind < argc) o->config = argv[optind++];
+    if (optind < argc) return fprintf(stderr, "granucal synthesize: unexpected argument '%s'\n", argv[optind]), 2;
+    if (o->jobs < 1) o->jobs = 1;
+    return 0;
+}
+
+/// One drum lining to make: its surface name in the data files and its cases.
+typedef struct lining {
+    const char *surface;
+    const pair *wall; ///< NULL: the drum lined with granules
+} lining;
+
+typedef struct job {
+    options opt;
+    cal_config *c;
+    const cal_tier *t;
+    cal_env env;
+    double k_n, gg_mu_s, gg_mu_r;
+    double rpm[MAX_SPEEDS], angle_rpm;
+    int n_rpm;
+    lining linings[MAX_WALLS + 1];
+    int n_linings;
+    char out[1024], err[2048];
+} job;
+
+// The speeds: the tier's, else every speed of the config's occupied-area
+// file for the granule lining (as a calibration takes them), and the angle's
+// speed from the config's angle file.
+static int choose_speeds(job *j)
+{
+    char path[1200];
+    cal_series angles, areas;
+    cal_config_data_path(j->c, j->c->repose_angle, path, sizeof path);
+    if (cal_series_load(&angles, path, CAL_DATA_ANGLE, j->err, sizeof j->err)) return 1;
+    const cal_point *p[64];
+    size_t n = cal_series_select(&angles, j->c->granule_surface, p, 64);
+    if (n > 0) j->angle_rpm = p[0]->rpm;
+    cal_series_free(&angles);
+    if (n == 0) return exp_fail(j->err, sizeof j->err, "%s: no angle for surface '%s'", path, j->c->granule_surface);
+    for (unsigned k = 0; k < j->t->rpm_count && j->n_rpm < MAX_SPEEDS; ++k) j->rpm[j->n_rpm++] = j->t->rpm[k];
+    if (j->n_rpm == 0) {
+        cal_config_data_path(j->c, j->c->occupied_area, path, sizeof path);
+        if (cal_series_load(&areas, path, CAL_DATA_CSA, j->err, sizeof j->err)) return 1;
+        n = cal_series_select(&areas, j->c->granule_surface, p, 64);
+        for (size_t k = 0; k < n && j->n_rpm < MAX_SPEEDS; ++k) j->rpm[j->n_rpm++] = p[k]->rpm;
+        cal_series_free(&areas);
+    }
+    int has_angle = 0;
+    for (int k = 0; k < j->n_rpm; ++k) has_angle |= j->rpm[k] == j->angle_rpm;
+    if (!has_angle && j->n_rpm < MAX_SPEEDS) j->rpm[j->n_rpm++] = j->angle_rpm;
+    return 0;
+}
+
+// The granule lining, then each config material with its --wall pair.
+static int choose_linings(job *j)
+{
+    j->linings[j->n_linings++] = (lining){j->c->granule_surface, NULL};
+    for (unsigned k = 0; k < j->c->materials_count; ++k) {
+        const cal_material *m = &j->c->materials[k];
+        const pair *w = NULL;
+        for (int i = 0; i < j->opt.n_walls; ++i)
+            if (strcasecmp(j->opt.walls[i].name, m->name) == 0) w = &j->opt.walls[i];
+        if (!w) return exp_fail(j->err, sizeof j->err, "no --wall %s=MU_S,MU_R for the material '%s' of %s", m->name, m->name, j->c->path);
+        j->linings[j->n_linings++] = (lining){m->surface, w};
+    }
+    for (int i = 0; i < j->opt.n_walls; ++i) {
+        int known = 0;
+        for (unsigned k = 0; k < j->c->materials_count; ++k) known |= strcasecmp(j->opt.walls[i].name, j->c->materials[k].name) == 0;
+        if (!known) return exp_fail(j->err, sizeof j->err, "--wall %s: not a material of %s", j->opt.walls[i].name, j->c->path);
+    }
+    for (int s = 0; s < j->opt.n_seeds; ++s)
+        if (j->opt.seeds[s] == j->c->seed)
+            return exp_fail(j->err, sizeof j->err, "--seeds: %ld is the seed of %s's calibration candidates; a twin needs other beds",
+                            j->opt.seeds[s], j->c->path);
+    return 0;
+}
+
+static cal_drum_case case_of(const job *j, const lining *l, long seed)
+{
+    cal_drum_case d = l->wall ? cal_drum_case_wall(j->c, j->t, j->k_n, j->gg_mu_s, j->gg_mu_r, l->wall->mu_s, l->wall->mu_r)
+                              : cal_drum_case_granule(j->c, j->t, j->k_n, j->gg_mu_s, j->gg_mu_r);
+    d.def.seed = d.fill.seed = (uint64_t)seed;
+    return d;
+}
+
+typedef struct summary {
+    double mean, se;
+    int n;
+} summary;
+
+static summary summarise(const double *v, int n)
+{
+    summary s = {NAN, NAN, n};
+    if (n == 0) return s;
+    double sum = 0, sq = 0;
+    for (int i = 0; i < n; ++i) sum += v[i];
+    s.mean = sum / n;
+    for (int i = 0; i < n; ++i) sq += (v[i] - s.mean) * (v[i] - s.mean);
+    s.se = n > 1 ? sqrt(sq / (n - 1) / n) : NAN;
+    return s;
+}
+
+/// Per lining and speed: the angle and CSA over the seeds.
+typedef struct lining_result {
+    summary angle[MAX_SPEEDS], csa[MAX_SPEEDS];
+} lining_result;
+
+// Run (or read from the store) one lining's seeds; a speed with no usable
+// run is an error: the data would have a hole the calibration would trip on.
+static int make_lining(job *j, const lining *l, lining_result *out)
+{
+    int n = j->opt.n_seeds;
+    cal_drum_case cases[MAX_SEEDS];
+    cal_record *rec = calloc((size_t)(n * j->n_rpm), sizeof *rec);
+    if (!rec) return exp_fail(j->err, sizeof j->err, "out of memory");
+    for (int s = 0; s < n; ++s) cases[s] = case_of(j, l, j->opt.seeds[s]);
+    cal_env_set_stage(&j->env, l->surface);
+    if (cal_drum_evaluate_many(&j->env, cases, n, j->rpm, j->n_rpm, rec, j->err, sizeof j->err)) return free(rec), 1;
+    int bad = 0;
+    for (int k = 0; k < j->n_rpm; ++k) {
+        double angle[MAX_SEEDS], csa[MAX_SEEDS];
+        int m = 0;
+        for (int s = 0; s < n; ++s) {
+            const cal_record *r = &rec[s * j->n_rpm + k];
+            if (cal_record_usable(r) && r->steady && isfinite(r->angle_deg)) angle[m] = r->angle_deg, csa[m++] = r->csa_percent;
+        }
+        out->angle[k] = summarise(angle, m), out->csa[k] = summarise(csa, m);
+        if (m == 0 && !bad)
+            bad = exp_fail(j->err, sizeof j->err, "%s at %g rpm: no seed reached a steady state (see %s/store)", l->surface,
+                           j->rpm[k], j->out);
+    }
+    for (int i = 0; i < n * j->n_rpm; ++i) cal_record_free(&rec[i]);
+    free(rec);
+    return bad;
+}
+
+static double spread_of(summary s) { return isfinite(s.se) ? fmax(s.se, 0.05) : 0.05; }
+
+static void write_header(FILE *f, const job *j, const char *what, const char *command)
+{
+    fprintf(f, "# SYNTHETIC - not lab data. %s made by the drum of tier '%s' (lambda %g, %s, max_time %g s)\n", what,
+            j->t->name, j->t->lambda, j->t->slice_depth > 0 ? "periodic slice" : "full drum", j->t->max_time);
+    fprintf(f, "# of %s, granucal %s (commit %s), k_n %g N/m, granule-granule mu_s %g mu_r %g", j->c->path, exp_version(),
+            cal_build_commit(), j->k_n,
+            j->gg_mu_s, j->gg_mu_r);
+    for (int i = 0; i < j->opt.n_walls; ++i)
+        fprintf(f, ", %s mu_s %g mu_r %g", j->opt.walls[i].name, j->opt.walls[i].mu_s, j->opt.walls[i].mu_r);
+    fprintf(f, ".\n# Mean over the usable runs of seeds");
+    for (int s = 0; s < j->opt.n_seeds; ++s) fprintf(f, "%s%ld", s ? "," : " ", j->opt.seeds[s]);
+    fprintf(f, "; spread = standard error of that mean (floor 0.05).\n# Made by: %s\n", command);
+}
+
+static int write_files(job *j, const lining_result *res, const char *command)
+{
+    char path[1200];
+    cal_atomic_file a;
+    snprintf(path, sizeof path, "%s/repose_angle.csv", j->out);
+    if (cal_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
+    write_header(a.f, j, "Dynamic angle of repose", command);
+    fputs("surface,rpm,angle_deg,angle_sd_deg\n", a.f);
+    for (int l = 0; l < j->n_linings; ++l)
+        for (int k = 0; k < j->n_rpm; ++k)
+            if (j->rpm[k] == j->angle_rpm)
+                fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], res[l].angle[k].mean, spread_of(res[l].angle[k]));
+    if (cal_atomic_commit(&a, j->err, sizeof j->err)) return 1;
+    snprintf(path, sizeof path, "%s/occupied_area.csv", j->out);
+    if (cal_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
+    write_header(a.f, j, "Occupied cross-section area (eq. 20)", command);
+    fputs("surface,rpm,csa_percent,csa_sd_percent\n", a.f);
+    for (int l = 0; l < j->n_linings; ++l)
+        for (int k = 0; k < j->n_rpm; ++k)
+            fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], res[l].csa[k].mean, spread_of(res[l].csa[k]));
+    return cal_atomic_commit(&a, j->err, sizeof j->err);
+}
+
+static int prepare(job *j)
+{
+    j->c = cal_config_load(j->opt.config, j->opt.tier, j->err, sizeof j->err);
+    if (!j->c) return 1;
+    j->t = cal_config_tier(j->c);
+    j->k_n = isfinite(j->opt.k_n) ? j->opt.k_n : j->c->k_n;
+    j->gg_mu_s = j->opt.has_granule ? j->opt.granule.mu_s : j->c->granule_mu_s;
+    j->gg_mu_r = j->opt.has_granule ? j->opt.granule.mu_r : j->c->granule_mu_r;
+    if (choose_speeds(j) || choose_linings(j)) return 1;
+    if (j->opt.out) snprintf(j->out, sizeof j->out, "%s", j->opt.out);
+    else snprintf(j->out, sizeof j->out, "results/synthetic-%.60s", j->t->name);
+    if (cal_prepare_output(j->out, j->err, sizeof j->err)) return 1;
+    snprintf(j->env.store, sizeof j->env.store, "%s/store", j->out);
+    j->env.workers = j->opt.jobs, j->env.use_fork = cal_mpi_size() == 1, j->env.tty = isatty(2);
+    j->env.checkpoint_every_s = CAL_CHECKPOINT_EVERY_S, j->env.started = exp_wall_seconds();
+    return 0;
+}
+
+int cal_cmd_synthesize(int argc, char **argv)
+{
+    job *j = calloc(1, sizeof *j);
+    if (!j) return fputs("granucal synthesize: out of memory\n", stderr), 1;
+    int status = parse_options(argc, argv, &j->opt);
+    if (status) return free(j), status < 0 ? 0 : status;
+    char command[2048] = "granucal";
+    for (int k = 0; k < argc; ++k) snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
+    cal_mpi_init(&argc, &argv);
+#ifdef _OPENMP
+    omp_set_num_threads(1); // parallel across simulations, one thread each (as calibrate)
+#endif
+    lining_result res[MAX_WALLS + 1];
+    status = prepare(j);
+    for (int l = 0; l < j->n_linings && !status; ++l) {
+        fprintf(stderr, "== %s: %d seed(s) x %d speed(s)\n", j->linings[l].surface, j->opt.n_seeds, j->n_rpm);
+        status = make_lining(j, &j->linings[l], &res[l]);
+    }
+    if (!status && cal_mpi_rank() == 0) {
+        status = write_files(j, res, command);
+        if (!status) fprintf(stderr, "granucal synthesize: wrote %s/repose_angle.csv and occupied_area.csv\n", j->out);
+    }
+    if (status) fprintf(stderr, "granucal synthesize: %s\n", j->err);
+    status = cal_mpi_any(status);
+    cal_sim_release(&j->env);
+    if (j->c) cal_config_free(j->c);
+    free(j);
+    cal_mpi_finalize();
+    return status ? 1 : 0;
+}

@@ -1,0 +1,185 @@
+// SPDX-License-Identifier: MIT
+// The two-fidelity search (calib/cal_multifidelity.c) on analytic responses,
+// where the expensive tier's optimum is known exactly: an "angle" and two
+// "CSA" values, smooth in (u, v), the cheap tier the same plus a bias it
+// cannot know. The objective is the friction stage's form: squared z-scores
+// against targets. Independent of any drum.
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "cal_multifidelity.h"
+
+enum { N_Y = 3 };
+static const double target[N_Y] = {34.6, 46.0, 60.0}, spread[N_Y] = {0.5, 0.6, 1.2};
+
+// The expensive tier's response: angle rising with both frictions, the CSA
+// curve steeper with μs at one speed and with μr at the other, one cross term.
+static void expensive_response(double u, double v, double *y)
+{
+    y[0] = 28 + 9 * u + 6 * v;
+    y[1] = 43 + 4 * u - 1.5 * v + 2 * u * u;
+    y[2] = 55 + 3 * u + 5 * v - 2 * u * v;
+}
+
+typedef struct twin {
+    double bias[N_Y];      ///< cheap - expensive, constant
+    double bias_slope_u;   ///< and a part linear in u, added to the angle
+    int runs, fail_at;     ///< expensive runs made; fail on this one (0: never)
+} twin;
+
+static void cheap_response(const twin *t, double u, double v, double *y)
+{
+    expensive_response(u, v, y);
+    for (int k = 0; k < N_Y; ++k) y[k] += t->bias[k];
+    y[0] += t->bias_slope_u * u;
+}
+
+static double objective(const double *y, void *ctx)
+{
+    (void)ctx;
+    double sum = 0;
+    for (int k = 0; k < N_Y; ++k) sum += (y[k] - target[k]) * (y[k] - target[k]) / (spread[k] * spread[k]);
+    return sum / N_Y;
+}
+
+static int run_expensive(double u, double v, double *y, void *ctx)
+{
+    twin *t = ctx;
+    if (++t->runs == t->fail_at) return 1;
+    expensive_response(u, v, y);
+    return 0;
+}
+
+// The cheap map from a g × g grid of cell centres.
+static void map_of(const twin *t, int g, cal_mf_map *map)
+{
+    cal_mf_point pts[64];
+    int n = 0;
+    for (int i = 0; i < g; ++i)
+        for (int j = 0; j < g; ++j) {
+            pts[n].u = (i + 0.5) / g, pts[n].v = (j + 0.5) / g;
+            cheap_response(t, pts[n].u, pts[n].v, pts[n].y);
+            n++;
+        }
+    assert_int_equal(cal_mf_fit(pts, n, N_Y, map), 0);
+}
+
+static cal_mf_problem problem_of(twin *t, int budget)
+{
+    static const double noise[N_Y] = {0.5, 0.6, 1.2};
+    return (cal_mf_problem){.n_y = N_Y, .objective = objective, .run_expensive = run_expensive, .noise = noise,
+                            .max_expensive = budget, .ctx = t};
+}
+
+// The expensive optimum, by brute force on a fine grid then the same polish.
+static void true_optimum(double *u, double *v)
+{
+    twin none = {{0}, 0, 0, 0};
+    cal_mf_map exact;
+    map_of(&none, 4, &exact); // quadratic responses: the quadratic map is exact
+    cal_mf_problem p = problem_of(&none, 0);
+    cal_mf_optimum(&exact, NULL, &p, u, v);
+}
+
+static void a_quadratic_is_fitted_exactly(void **state)
+{
+    (void)state;
+    twin t = {{1.5, -2.0, 0.7}, 0, 0, 0};
+    cal_mf_map map;
+    map_of(&t, 3, &map);
+    assert_int_equal(map.n_terms, 6);
+    for (double u = 0; u <= 1; u += 0.25)
+        for (double v = 0; v <= 1; v += 0.25) {
+            double want[N_Y], got[N_Y];
+            cheap_response(&t, u, v, want);
+            cal_mf_predict(&map, NULL, u, v, got);
+            for (int k = 0; k < N_Y; ++k) assert_true(fabs(want[k] - got[k]) < 1e-9);
+        }
+}
+
+static void too_few_points_are_refused(void **state)
+{
+    (void)state;
+    cal_mf_point pts[2] = {{0.1, 0.1, {1, 2, 3}}, {0.9, 0.9, {2, 3, 4}}};
+    cal_mf_map map;
+    assert_int_equal(cal_mf_fit(pts, 2, N_Y, &map), 1);
+}
+
+// A constant bias between the tiers: the first expensive run measures it
+// exactly, the corrected map is the expensive response, and the second run
+// lands on the expensive optimum and agrees with its prediction.
+static void a_constant_bias_is_measured_and_removed(void **state)
+{
+    (void)state;
+    twin t = {{7.6, 1.5, -2.0}, 0, 0, 0};
+    cal_mf_map map;
+    map_of(&t, 3, &map);
+    cal_mf_problem p = problem_of(&t, 6);
+    cal_mf_result r;
+    assert_int_equal(cal_mf_search(&map, &p, &r), 0);
+    double u, v;
+    true_optimum(&u, &v);
+    // The test can fail: the cheap map's own optimum is far from the truth.
+    assert_true(hypot(r.u_uncorrected - u, r.v_uncorrected - v) > 0.1);
+    assert_false(r.failed);
+    assert_true(r.agreed);
+    assert_int_equal(r.n, 2);
+    assert_true(fabs(r.run[r.n - 1].u - u) < 1e-3 && fabs(r.run[r.n - 1].v - v) < 1e-3);
+    for (int k = 0; k < N_Y; ++k) assert_true(fabs(r.delta[k] + t.bias[k]) < 1e-6);
+}
+
+// A bias that varies over the square: the additive correction is exact only
+// where it was measured, so the loop needs more runs; it must still end
+// within the noise of the truth's objective, inside its budget.
+static void a_varying_bias_converges_within_noise(void **state)
+{
+    (void)state;
+    twin t = {{7.6, 1.5, -2.0}, 3.0, 0, 0};
+    cal_mf_map map;
+    map_of(&t, 4, &map);
+    cal_mf_problem p = problem_of(&t, 8);
+    cal_mf_result r;
+    cal_mf_search(&map, &p, &r);
+    assert_false(r.failed);
+    assert_true(r.agreed || r.settled);
+    assert_true(r.n <= 8);
+    double u, v, best[N_Y], got[N_Y];
+    true_optimum(&u, &v);
+    expensive_response(u, v, best);
+    expensive_response(r.run[r.n - 1].u, r.run[r.n - 1].v, got);
+    // Within one unit of the objective (one standard deviation in the mean
+    // squared z-score) of the best the expensive tier can do.
+    assert_true(objective(got, NULL) - objective(best, NULL) < 1.0);
+}
+
+static void a_failed_run_stops_the_loop(void **state)
+{
+    (void)state;
+    twin t = {{7.6, 1.5, -2.0}, 0, 0, 1};
+    cal_mf_map map;
+    map_of(&t, 3, &map);
+    cal_mf_problem p = problem_of(&t, 6);
+    cal_mf_result r;
+    cal_mf_search(&map, &p, &r);
+    assert_true(r.failed);
+    assert_int_equal(r.n, 0);
+    assert_int_equal(t.runs, 1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(a_quadratic_is_fitted_exactly),
+        cmocka_unit_test(too_few_points_are_refused),
+        cmocka_unit_test(a_constant_bias_is_measured_and_removed),
+        cmocka_unit_test(a_varying_bias_converges_within_noise),
+        cmocka_unit_test(a_failed_run_stops_the_loop),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
