@@ -51,6 +51,7 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_ENUM_PTR("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, bound_probes, yes_no,
                          CYAML_ARRAY_LEN(yes_no)),
     CYAML_FIELD_STRING_PTR("map_tier", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, map_tier, 1, 31),
+    CYAML_FIELD_INT("beds", CYAML_FLAG_OPTIONAL, cal_tier, beds),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -214,6 +215,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
     if (t->seeds < 1 || t->seeds > 64) return located(c, from, "seeds", err, len, "%d must be in [1, 64]", t->seeds);
     if (t->grid < 0 || t->grid > 16) return located(c, from, "grid", err, len, "%d must be in [0, 16]", t->grid);
+    if (t->beds < 0 || t->beds > 16) return located(c, from, "beds", err, len, "%d must be in [1, 16]", t->beds);
     if (t->max_evaluations < 0 || t->max_evaluations > 1000)
         return located(c, from, "max_evaluations", err, len, "%d must be in [0, 1000]", t->max_evaluations);
     if (t->grid < 2 && t->max_evaluations < 1)
@@ -237,6 +239,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 }
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
+int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
 double cal_tier_csa_sd(const cal_tier *t, unsigned i)
 {

@@ -62,10 +62,17 @@ typedef struct cal_tier {
     /// measures between the two, puts the optimum; max_evaluations bounds
     /// those runs and grid is unused. NULL: a one-tier search.
     char *map_tier;
+    /// Beds each drum candidate is run on (seeds seed, seed+1, ...), its
+    /// measurements the mean over them. angle_sd_deg and csa_sd_percent stay
+    /// one bed's spreads, as measured; the search divides them by sqrt(beds)
+    /// (independent packings). 0: one.
+    int beds;
 } cal_tier;
 
 /// 1 if the tier puts the angle into the misfit instead of a constraint.
 int cal_tier_angle_in_misfit(const cal_tier *t);
+/// Beds per drum candidate (1 when not given).
+int cal_tier_beds(const cal_tier *t);
 /// 1 if the tier probes the μr bounds after the search (the default).
 int cal_tier_bound_probes(const cal_tier *t);
 /// The tier's CSA spread at speed index i of its rpm list (0: not measured).

@@ -296,33 +296,37 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
 
 // ---- every simulation ------------------------------------------------------------
 
-static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store)
+// Candidate i's records on bed b, one row a speed (the stage's own records:
+// a two-tier stage's predicted candidates are the map tier's runs).
+static void bed_simulations(FILE *f, const cal_outcome *o, const cal_friction_result *r, int i, int b, const char *store)
 {
     const char *stage = r->material[0] ? r->material : "granule";
-    for (int i = 0; i < r->n; ++i) {
-        const cal_candidate *k = &r->cand[i];
-        cal_drum_case dc = r->material[0]
-                               ? cal_drum_case_wall(o->config, o->tier, r->k_n, r->frozen_mu_s, r->frozen_mu_r, k->mu_s, k->mu_r)
-                               : cal_drum_case_granule(o->config, o->tier, r->k_n, k->mu_s, k->mu_r);
-        double rpm[CAL_MAX_RPM + 1];
-        int n = r->n_rpm;
-        memcpy(rpm, r->rpm, sizeof(double) * (size_t)n);
-        int has_angle = 0;
-        for (int j = 0; j < n; ++j) has_angle |= rpm[j] == r->angle_rpm;
-        if (!has_angle) rpm[n++] = r->angle_rpm;
-        for (int j = 0; j < n; ++j) {
-            char key[2048], hash[17], err[256];
-            cal_drum_key(&dc, rpm[j], key, sizeof key);
-            cal_store_hash(key, hash);
-            cal_record rec;
-            if (cal_store_get(store, key, &rec, err, sizeof err) != 0) continue;
-            fprintf(f, "%s,%d,%s,drum,%.6g,%.6g,%g,%s,\"%s\",%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.1f,%.1f,%.4g,%d,%.6g,%.1f\n",
-                    stage, i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
-                    rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s,
-                    rec.wall_time_s, rec.fill_wall_time_s, rec.particle_steps, rec.granules, rec.dt_s, rec.peak_rss_mb);
-            cal_record_free(&rec);
-        }
+    const cal_candidate *k = &r->cand[i];
+    cal_drum_case dc = cal_friction_case(o->config, o->tier, r, k->mu_s, k->mu_r, b);
+    double rpm[CAL_MAX_RPM + 1];
+    int n = r->n_rpm;
+    memcpy(rpm, r->rpm, sizeof(double) * (size_t)n);
+    int has_angle = 0;
+    for (int j = 0; j < n; ++j) has_angle |= rpm[j] == r->angle_rpm;
+    if (!has_angle) rpm[n++] = r->angle_rpm;
+    for (int j = 0; j < n; ++j) {
+        char key[2048], hash[17], err[256];
+        cal_drum_key(&dc, rpm[j], key, sizeof key);
+        cal_store_hash(key, hash);
+        cal_record rec;
+        if (cal_store_get(store, key, &rec, err, sizeof err) != 0) continue;
+        fprintf(f, "%s,%d,%s,drum,%.6g,%.6g,%g,%s,\"%s\",%.4f,%.4f,%.4f,%.4f,%d,%.4f,%.1f,%.1f,%.4g,%d,%.6g,%.1f\n", stage,
+                i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
+                rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s, rec.wall_time_s,
+                rec.fill_wall_time_s, rec.particle_steps, rec.granules, rec.dt_s, rec.peak_rss_mb);
+        cal_record_free(&rec);
     }
+}
+
+static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store)
+{
+    for (int i = 0; i < r->n; ++i)
+        for (int b = 0; b < cal_tier_beds(o->tier) && !r->cand[i].predicted; ++b) bed_simulations(f, o, r, i, b, store);
 }
 
 static int write_simulations(const char *dir, const char *store, const cal_outcome *o, char *err, size_t len)
@@ -487,9 +491,10 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
     FILE *f = a.f;
     const cal_tier *t = o->tier;
     fprintf(f, "# granucal calibration\n\nCommand: `%s`  \nConfig: `%s`, tier `%s` (drum λ = %g, %s, up to %g s per "
-               "speed, window %g s; cylinder λ = %g), granucal %s, %d rank(s) × %d worker(s), %.0f s wall.\n\n",
+               "speed, window %g s; cylinder λ = %g), granucal %s (commit %s), %d rank(s) × %d worker(s), %.0f s wall.\n\n",
             o->command, o->config->path, t->name, t->lambda, t->slice_depth > 0 ? "periodic slice" : "full drum",
-            t->max_time, t->window, t->cylinder_lambda, exp_version(), o->ranks, o->workers, o->wall_time_s);
+            t->max_time, t->window, t->cylinder_lambda, exp_version(), cal_build_commit(), o->ranks, o->workers,
+            o->wall_time_s);
     fputs("Files: `calibrated_parameters.{csv,md,h5}`, `simulations.csv` (every simulation, its cost and status), "
           "plots `cn_vs_k.png`, `angle_map_*.png`, `csa_vs_rpm_*.png`, `convergence_*.png`, and "
           "`liggghts_parameters.in`, `lammps_parameters.in`.\n", f);

@@ -45,6 +45,7 @@ typedef struct cal_friction_search {
     cal_friction_result *r;
     double sim_rpm[CAL_MAX_RPM]; ///< speeds simulated: the CSA speeds, and the angle's
     int n_sim, angle_index;
+    int beds;                    ///< beds (seeds) each candidate is run on and averaged over
     int failed;                  ///< the store failed: stop the search
     nlopt_opt opt;
     double started;              ///< wall clock at the stage's start, for the ETA
@@ -108,18 +109,40 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
 }
 
 // The candidate's measurements from its records, then its scores.
+// Speed j's measurement averaged over the candidate's beds (rec: beds ×
+// n_sim records, by bed): the angle over the usable runs, the CSA over the
+// usable and steady ones; NAN where none is.
+typedef struct bed_mean {
+    double angle, angle_sd, csa, csa_sd;
+    int n_angle, n_csa;
+} bed_mean;
+
+static bed_mean mean_over_beds(const search *s, const cal_record *rec, int j)
+{
+    bed_mean m = {0};
+    for (int b = 0; b < s->beds; ++b) {
+        const cal_record *x = &rec[b * s->n_sim + j];
+        if (!cal_record_usable(x)) continue;
+        m.angle += x->angle_deg, m.angle_sd += x->angle_sd_deg, m.n_angle++;
+        if (x->steady) m.csa += x->csa_percent, m.csa_sd += x->csa_sd_percent, m.n_csa++;
+    }
+    m.angle = m.n_angle ? m.angle / m.n_angle : NAN, m.angle_sd = m.n_angle ? m.angle_sd / m.n_angle : NAN;
+    m.csa = m.n_csa ? m.csa / m.n_csa : NAN, m.csa_sd = m.n_csa ? m.csa_sd / m.n_csa : NAN;
+    return m;
+}
+
 static void score(search *s, cal_candidate *k, const cal_record *rec)
 {
     cal_friction_result *r = s->r;
-    const cal_record *a = &rec[s->angle_index];
-    k->angle_deg = cal_record_usable(a) ? a->angle_deg : NAN;
-    k->angle_sd_deg = a->angle_sd_deg;
+    bed_mean a = mean_over_beds(s, rec, s->angle_index);
+    k->angle_deg = a.angle, k->angle_sd_deg = a.angle_sd;
     for (int i = 0; i < r->n_rpm; ++i) {
-        const cal_record *x = NULL;
+        int x = -1;
         for (int j = 0; j < s->n_sim; ++j)
-            if (s->sim_rpm[j] == r->rpm[i]) x = &rec[j];
-        k->usable[i] = x && cal_record_usable(x) && x->steady;
-        k->csa[i] = x ? x->csa_percent : NAN, k->csa_sd[i] = x ? x->csa_sd_percent : NAN;
+            if (s->sim_rpm[j] == r->rpm[i]) x = j;
+        bed_mean m = x >= 0 ? mean_over_beds(s, rec, x) : (bed_mean){NAN, NAN, NAN, NAN, 0, 0};
+        k->usable[i] = m.n_csa > 0;
+        k->csa[i] = m.csa, k->csa_sd[i] = m.csa_sd;
     }
     cal_candidate_score(r, k);
 }
@@ -164,7 +187,7 @@ static void add_candidate(search *s, double mu_s, double mu_r, const char *origi
     memset(k, 0, sizeof *k);
     k->mu_s = mu_s, k->mu_r = mu_r, k->origin = origin;
     score(s, k, rec);
-    for (int i = 0; i < s->n_sim; ++i) // turning, and settling where this candidate settled a bed
+    for (int i = 0; i < s->beds * s->n_sim; ++i) // turning, and settling where this candidate settled a bed
         k->wall_time_s += cal_record_cost_s(&rec[i]), cal_record_free(&rec[i]);
     char with_angle[48] = "", took[48];
     if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", with the angle %.3g", k->objective);
@@ -182,8 +205,8 @@ static void evaluate_points(search *s, const double (*mu)[2], int m, const char 
 {
     cal_friction_result *r = s->r;
     double(*fresh)[2] = calloc((size_t)m, sizeof *fresh);
-    cal_drum_case *cases = calloc((size_t)m, sizeof *cases);
-    cal_record *rec = calloc((size_t)m * (size_t)s->n_sim, sizeof *rec);
+    cal_drum_case *cases = calloc((size_t)(m * s->beds), sizeof *cases);
+    cal_record *rec = calloc((size_t)(m * s->beds) * (size_t)s->n_sim, sizeof *rec);
     int n = 0;
     if (!fresh || !cases || !rec) s->failed = 1, exp_fail(s->err, s->len, "out of memory");
     for (int p = 0; p < m && !s->failed; ++p) {
@@ -191,17 +214,27 @@ static void evaluate_points(search *s, const double (*mu)[2], int m, const char 
         for (int q = 0; q < n; ++q) again |= same_value(fresh[q][0], mu[p][0]) && same_value(fresh[q][1], mu[p][1]);
         if (again || r->n + n >= CAL_MAX_EVALS) continue;
         fresh[n][0] = mu[p][0], fresh[n][1] = mu[p][1];
-        cases[n++] = s->material ? cal_drum_case_wall(s->c, s->t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu[p][0], mu[p][1])
-                                 : cal_drum_case_granule(s->c, s->t, r->k_n, mu[p][0], mu[p][1]);
+        for (int b = 0; b < s->beds; ++b) cases[n * s->beds + b] = cal_friction_case(s->c, s->t, r, mu[p][0], mu[p][1], b);
+        n++;
     }
     if (n > 0 && !s->failed) {
         double t0 = exp_wall_seconds();
         show_start(s, (const double(*)[2])fresh, n);
-        if (cal_drum_evaluate_many(s->env, cases, n, s->sim_rpm, s->n_sim, rec, s->err, s->len)) s->failed = 1;
+        if (cal_drum_evaluate_many(s->env, cases, n * s->beds, s->sim_rpm, s->n_sim, rec, s->err, s->len)) s->failed = 1;
         double elapsed = exp_wall_seconds() - t0;
-        for (int j = 0; j < n && !s->failed; ++j) add_candidate(s, fresh[j][0], fresh[j][1], origin, rec + j * s->n_sim, elapsed, n);
+        for (int j = 0; j < n && !s->failed; ++j)
+            add_candidate(s, fresh[j][0], fresh[j][1], origin, rec + j * s->beds * s->n_sim, elapsed, n);
     }
     free(fresh), free(cases), free(rec);
+}
+
+cal_drum_case cal_friction_case(const cal_config *c, const cal_tier *t, const cal_friction_result *r, double mu_s,
+                                double mu_r, int bed)
+{
+    cal_drum_case d = r->material[0] ? cal_drum_case_wall(c, t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
+                                     : cal_drum_case_granule(c, t, r->k_n, mu_s, mu_r);
+    d.def.seed = d.fill.seed = (uint64_t)(c->seed + bed); // bed 0: the config's seed, a one-bed tier's run
+    return d;
 }
 
 static cal_candidate *evaluate(search *s, double mu_s, double mu_r, const char *origin)
@@ -379,7 +412,9 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     // granules pile steeper, Table B.1) is not corrected here by a number
     // measured at any known answer; the tier's table is the tier's.
     r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
-    r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + s->t->angle_sd_deg * s->t->angle_sd_deg);
+    // The tier's spreads are one bed's; a candidate is the mean of its beds.
+    double per_bed = 1 / sqrt(cal_tier_beds(s->t)), tier_angle_sd = s->t->angle_sd_deg * per_bed;
+    r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + tier_angle_sd * tier_angle_sd);
     n = cal_series_select(areas, r->surface, pts, 64);
     if (n == 0) return exp_fail(s->err, s->len, "%s: no occupied area for surface '%s'", areas->path, r->surface);
     for (size_t i = 0; i < n; ++i) {
@@ -388,7 +423,7 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
         if (!wanted) continue;
         if (r->n_rpm == CAL_MAX_RPM) return exp_fail(s->err, s->len, "at most %d speeds", CAL_MAX_RPM);
         r->rpm[r->n_rpm] = pts[i]->rpm, r->csa_data[r->n_rpm] = pts[i]->value, r->csa_data_sd[r->n_rpm] = pts[i]->sd;
-        r->csa_tier_sd[r->n_rpm] = cal_tier_csa_sd(s->t, tier_index_of(s->t, pts[i]->rpm));
+        r->csa_tier_sd[r->n_rpm] = cal_tier_csa_sd(s->t, tier_index_of(s->t, pts[i]->rpm)) * per_bed;
         s->sim_rpm[s->n_sim++] = pts[i]->rpm;
         r->n_rpm++;
     }
@@ -408,7 +443,7 @@ int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_
     if (!r) return -1;
     snprintf(r->surface, sizeof r->surface, "%s", material ? material->surface : c->granule_surface);
     search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = sizeof err};
-    int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t);
+    int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t) * cal_tier_beds(t);
     free(r);
     const cal_tier *map = t->map_tier ? cal_config_tier_named(c, t->map_tier) : NULL;
     int map_runs = map && runs >= 0 ? cal_friction_planned_runs(c, map, angles, areas, material) : 0;
@@ -429,7 +464,7 @@ cal_friction_search *cal_friction_begin(cal_env *env, const cal_config *c, const
     search *s = calloc(1, sizeof *s);
     if (!s) return exp_fail(err, len, "out of memory"), NULL;
     *s = (search){.env = env, .c = c, .t = t, .material = material, .r = out, .err = err, .len = len,
-                  .started = exp_wall_seconds()};
+                  .started = exp_wall_seconds(), .beds = cal_tier_beds(t)};
     if (set_targets(s, angles, areas)) return free(s), NULL;
     return s;
 }

@@ -149,6 +149,11 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, char *err, size_t len);
 
+/// The drum case of the stage r at (mu_s, mu_r) on bed `bed` (seed + bed):
+/// what the search runs, and what the report looks up in the store.
+cal_drum_case cal_friction_case(const cal_config *c, const cal_tier *t, const cal_friction_result *r, double mu_s,
+                                double mu_r, int bed);
+
 /// The unit square's (u, v) as (μs, log μr) within bounds b, and back.
 void cal_friction_to_mu(const cal_bounds *b, double u, double v, double *mu_s, double *mu_r);
 void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double *u, double *v);

@@ -411,9 +411,9 @@ static int write_markdown(const study *s, const char *command, double wall, char
     snprintf(path, sizeof path, "%s/fidelity.md", s->out);
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *o = a.f;
-    fprintf(o, "# What accuracy costs in time: the drum fidelity ladder\n\nCommand: `%s`  \ngranucal %s, config `%s`, "
-               "%.0f s wall for this run (stored simulations are not rerun).  \n",
-            command, exp_version(), s->c->path, wall);
+    fprintf(o, "# What accuracy costs in time: the drum fidelity ladder\n\nCommand: `%s`  \ngranucal %s (commit %s), "
+               "config `%s`, %.0f s wall for this run (stored simulations are not rerun).  \n",
+            command, exp_version(), cal_build_commit(), s->c->path, wall);
     machine_line(o);
     fprintf(o, "Drum lined with granules, granule-granule pair μs = %g, μr = %g, k_n = %g N/m; %d seed(s) per rung; "
                "speeds",

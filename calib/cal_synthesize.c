@@ -210,10 +210,10 @@ static int choose_linings(job *j)
         for (unsigned k = 0; k < j->c->materials_count; ++k) known |= strcasecmp(j->opt.walls[i].name, j->c->materials[k].name) == 0;
         if (!known) return exp_fail(j->err, sizeof j->err, "--wall %s: not a material of %s", j->opt.walls[i].name, j->c->path);
     }
-    for (int s = 0; s < j->opt.n_seeds; ++s)
-        if (j->opt.seeds[s] == j->c->seed)
-            return exp_fail(j->err, sizeof j->err, "--seeds: %ld is the seed of %s's calibration candidates; a twin needs other beds",
-                            j->opt.seeds[s], j->c->path);
+    for (int s = 0; s < j->opt.n_seeds; ++s) // the candidates' beds: seed, seed + 1, ... (cal_tier_beds)
+        if (j->opt.seeds[s] >= j->c->seed && j->opt.seeds[s] < j->c->seed + cal_tier_beds(j->t))
+            return exp_fail(j->err, sizeof j->err, "--seeds: %ld is a bed of %s's calibration candidates at tier '%s'; a "
+                            "twin needs other beds", j->opt.seeds[s], j->c->path, j->t->name);
     return 0;
 }
 

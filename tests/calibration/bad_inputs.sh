@@ -13,11 +13,12 @@ for s in "spray-dried powder" Aluminium PP PTFE; do
 done
 sed 's|\.\./experiments/data/|../data/|' "$src/configs/calibration.yaml" > "$work/configs/good.yaml"
 fails=0
-# expect NAME EXPECTED-TEXT -- ARGS...: non-zero exit, the text in stderr, under 20 s.
+# expect NAME EXPECTED-TEXT -- ARGS...: non-zero exit, the text in stderr, under 20 s
+# (the command: calibrate, or $cmd when set for the call).
 expect() {
   local name=$1 want=$2; shift 3
   local start=$SECONDS out
-  out=$(timeout 20 "$bin" calibrate "$@" 2>&1 >/dev/null); local code=$?
+  out=$(timeout 20 "$bin" "${cmd:-calibrate}" "$@" 2>&1 >/dev/null); local code=$?
   if [ $code -eq 0 ] || [ $code -eq 124 ] || ! grep -qF -- "$want" <<< "$out"; then
     echo "FAIL $name: exit $code, wanted '$want' in: $out"; fails=$((fails + 1))
   else
@@ -64,6 +65,14 @@ expect "extra fields, angle file" "extra_angle.csv:2: row: has 7 fields, expecte
 expect "extra fields, CSA file" "extra_csa.csv:3: row: has 7 fields, expected 4" -- "$(csa extra_csa '# lab\nsurface,rpm,csa_percent,csa_sd_percent\nPTFE,4,45,0.5,1,2,3\nPTFE,40,50,0.5\n')" "${out[@]}"
 expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
 expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
+expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
+expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
+# granucal synthesize (twin data): pairs and beds checked before the first run.
+walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
+cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"
+cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': need NAME=MU_S,MU_R" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
+cmd=synthesize expect "twin: a wall not in the config" "--wall granite: not a material" -- "$work/configs/good.yaml" "${walls[@]}" --wall granite=0.5,0.1 "${out[@]}"
+cmd=synthesize expect "twin: on the candidates' own bed" "--seeds: 2 is a bed of" -- "$work/configs/good.yaml" "${walls[@]}" --tier ci --seeds 2,101 "${out[@]}"
 [ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }
 echo "$fails failure(s)"
 exit $((fails > 0))

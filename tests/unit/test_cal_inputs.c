@@ -159,6 +159,16 @@ static void test_shipped_config_loads(void **state)
     c = cal_config_load(path, "quick", err, sizeof err);
     if (!c) fail_msg("%s", err);
     assert_true(cal_tier_csa_sd(cal_config_tier(c), 0) == 3.1);
+    assert_int_equal(cal_tier_beds(cal_config_tier(c)), 1); // absent: one bed
+    cal_config_free(c);
+    // ci's two beds; standard's map tier, its speeds the ci tier's.
+    c = cal_config_load(path, "standard", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    const cal_tier *standard = cal_config_tier(c), *map = cal_config_tier_named(c, standard->map_tier);
+    assert_non_null(map);
+    assert_string_equal(map->name, "ci");
+    assert_int_equal(cal_tier_beds(map), 2);
+    assert_int_equal(map->rpm_count, standard->rpm_count);
     cal_config_free(c);
 }
 
@@ -221,6 +231,10 @@ static void test_bad_config_named_by_line_and_field(void **state)
     expect_config_error("stiffness: [50, 100", "stiffness: [100, 50", "stiffness"); // not increasing
     expect_config_error("max_evaluations: 1\n    # Its drum", "max_evaluations: -2\n    # Its drum",
                         "max_evaluations");                                 // in a tier's own block
+    expect_config_error("map_tier: ci", "map_tier: cheap", "map_tier");     // no such tier
+    expect_config_error("map_tier: ci", "map_tier: standard", "map_tier");  // itself
+    expect_config_error("map_tier: ci", "map_tier: quick", "map_tier");     // other speeds
+    expect_config_error("beds: 2", "beds: 40", "beds");
 }
 
 // What fuzzing the loaders found (tests/fuzz): each was accepted, or crashed.
@@ -451,6 +465,10 @@ static void test_identified_ranges(void **state)
     assert_true(r.cand[0].identified && r.cand[1].identified && !r.cand[2].identified);
     assert_true(r.mu_s_range.lo == 0.5 && r.mu_s_range.hi == 0.6 && isnan(r.mu_s_range.below) && r.mu_s_range.above == 0.7);
     assert_true(r.mu_r_range.lo == 0.001 && r.mu_r_range.hi == 0.01 && isnan(r.mu_r_range.below) && r.mu_r_range.above == 0.1);
+    // The interval not excluded: to the excluded C above, to the search bound below (nothing excluded there).
+    cal_range_bracket(&r.mu_s_range, 0.1, 1.0), cal_range_bracket(&r.mu_r_range, 1e-3, 0.5);
+    assert_true(r.mu_s_range.bracket_lo == 0.1 && r.mu_s_range.bracket_hi == 0.7);
+    assert_true(r.mu_r_range.bracket_lo == 1e-3 && r.mu_r_range.bracket_hi == 0.1);
     // A failed speed counts as 5 spreads: C with its CSA lost is told apart.
     r.cand[2].usable[0] = 0;
     cal_friction_identify(&r);
