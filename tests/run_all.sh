@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash .ci/setup
 ctest --test-dir build --output-on-failure -j1 -LE table3
-# Table 3 end to end at the ci tier (label table3; docs/calibration.md): 661 s on 2 cores here at b972e69, 669 s at d11c2ec, 628 s at a932819, 599 s at 30a5af4, 412 s at cef81a5 (903 s before the contact batch; results/table3_ci/r4_batched/).
+# Table 3 at the ci tier as a twin experiment (label table3; results/twin_ci/README.md): 868 s on 2 cores here at 6febfdb, one of them running a study.
 ctest --test-dir build --output-on-failure -j1 -L table3
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRANUCAL_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$(nproc)" >/dev/null
