@@ -354,6 +354,19 @@ static void print_table(const char *dir)
     printf("\nresults: %s (report.md, calibrated_parameters.csv, plots)\n", dir);
 }
 
+// A friction stage's plan: with a map tier, the map's runs as a step of their
+// own ("NAME (map)", their own cost), then this tier's.
+static void plan_friction(run *r, const char *name, const cal_material *m)
+{
+    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
+    if (map) {
+        char label[64];
+        snprintf(label, sizeof label, "%.50s (map)", name);
+        cal_progress_plan(&r->progress, label, CAL_RUN_MAP_DRUM, cal_friction_planned_runs(r->c, map, &r->angles, &r->areas, m));
+    }
+    cal_progress_plan(&r->progress, name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
+}
+
 // Every stage this run will do, with the simulations it may take, so that
 // progress lines can say how far the whole calibration is and the time left.
 static void plan_progress(run *r)
@@ -361,12 +374,10 @@ static void plan_progress(run *r)
     cal_progress *p = &r->progress;
     cal_progress_init(p, r->env.workers * cal_mpi_size());
     if (wants(r, "stiffness")) cal_progress_plan(p, "stiffness", CAL_RUN_CYLINDER, (int)r->c->stiffness_count * r->t->seeds);
-    if (wants(r, "granule"))
-        cal_progress_plan(p, "granule", CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, NULL));
+    if (wants(r, "granule")) plan_friction(r, "granule", NULL);
     for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
         const cal_material *m = &r->c->materials[k];
-        if (!r->opt.material || strcasecmp(r->opt.material, m->name) == 0)
-            cal_progress_plan(p, m->name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
+        if (!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) plan_friction(r, m->name, m);
     }
     r->env.progress = p;
 }

@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *const kind_name[CAL_RUN_KINDS] = {"cylinder", "drum"};
+static const char *const kind_name[CAL_RUN_KINDS] = {"cylinder", "drum", "map-tier drum"};
 
 void cal_progress_init(cal_progress *p, int parallel)
 {

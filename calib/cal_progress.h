@@ -14,12 +14,14 @@
 
 #include <stddef.h>
 
-typedef enum cal_run_kind { CAL_RUN_CYLINDER = 0, CAL_RUN_DRUM = 1, CAL_RUN_KINDS = 2 } cal_run_kind;
+/// Kinds of simulation, each with its own cost: a two-tier stage's map-tier
+/// drum runs cost a small part of the tier's own.
+typedef enum cal_run_kind { CAL_RUN_CYLINDER = 0, CAL_RUN_DRUM = 1, CAL_RUN_MAP_DRUM = 2, CAL_RUN_KINDS = 3 } cal_run_kind;
 
 enum { CAL_PROGRESS_MAX_STAGES = 20 };
 
 typedef struct cal_progress_stage {
-    char name[32];
+    char name[64]; ///< a material's name (< 32), with " (map)" for a map tier's step
     cal_run_kind kind;
     int planned; ///< at most this many simulations
     int done;    ///< run now or found in the store

@@ -15,6 +15,9 @@
 #include "exp_common.h"
 #include "exp_contact_rules.h"
 
+// How this environment's drum runs are counted in the progress.
+static cal_run_kind drum_kind(const cal_env *env) { return env->mapping ? CAL_RUN_MAP_DRUM : CAL_RUN_DRUM; }
+
 // The config's damping reading (its name was checked when the config was loaded).
 static dem_damping_mode config_damping(const cal_config *c)
 {
@@ -316,7 +319,7 @@ static void show_run(drum_batch *b, drum_run r, int code, int n_cases)
     const dem_contact_params *p = &b->cases[r.c].def.wall; // the granule stage's wall pair is its granule pair
     if (n_cases > 1) snprintf(what, sizeof what, "mu_s = %.4g, mu_r = %.4g, %g rpm", p->mu_s, p->mu_r, b->rpm[r.k]);
     else snprintf(what, sizeof what, "%g rpm", b->rpm[r.k]);
-    finish_run(b->env, CAL_RUN_DRUM, run_key(b, r), what, code);
+    finish_run(b->env, drum_kind(b->env), run_key(b, r), what, code);
 }
 
 static void turned(int i, int code, void *ctx)
@@ -332,7 +335,11 @@ static void settled_and_turned(int i, int code, void *ctx)
         if (b->todo[j].c == b->case_todo[i]) show_run(b, b->todo[j], code, b->n_cases);
 }
 
-void cal_env_set_stage(cal_env *env, const char *stage) { snprintf(env->stage, sizeof env->stage, "%s", stage); }
+void cal_env_set_stage(cal_env *env, const char *stage)
+{
+    snprintf(env->stage, sizeof env->stage, env->mapping ? "%.50s (map)" : "%s", stage);
+}
+
 
 void cal_sim_release(cal_env *env)
 {
@@ -430,7 +437,7 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
             int got = cal_store_get(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
             bad = got < 0;
             if (got == 1) missing[n_missing++] = (drum_run){c, k};
-            if (got == 0) count_stored(env, CAL_RUN_DRUM, &out[c * n + k]);
+            if (got == 0) count_stored(env, drum_kind(env), &out[c * n + k]);
         }
     if (!bad && n_missing > 0) run_missing_drum(&b, missing, n_missing);
     cal_mpi_barrier(); // every rank's records are on the shared store now
@@ -438,7 +445,7 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     while (!bad && read < runs) bad = read_back(env, b.keys[read], &out[read], err, len), read += !bad;
     for (int i = 0; i < n_missing && !bad; ++i) // other ranks' runs
         if (!ran_here(&b, missing[i]))
-            cal_progress_count(env->progress, CAL_RUN_DRUM, cal_record_cost_s(&out[missing[i].c * n + missing[i].k]));
+            cal_progress_count(env->progress, drum_kind(env), cal_record_cost_s(&out[missing[i].c * n + missing[i].k]));
     if (bad) // the caller gets no records: release those read
         while (read > 0) cal_record_free(&out[--read]);
     free(b.keys), free(b.todo), free(b.case_todo), free(missing);

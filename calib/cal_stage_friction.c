@@ -189,6 +189,7 @@ static void add_candidate(search *s, double mu_s, double mu_r, const char *origi
     score(s, k, rec);
     for (int i = 0; i < s->beds * s->n_sim; ++i) // turning, and settling where this candidate settled a bed
         k->wall_time_s += cal_record_cost_s(&rec[i]), cal_record_free(&rec[i]);
+    r->simulations += s->beds * s->n_sim, r->core_s += k->wall_time_s;
     char with_angle[48] = "", took[48];
     if (r->angle_in_misfit) snprintf(with_angle, sizeof with_angle, ", with the angle %.3g", k->objective);
     if (together > 1) snprintf(took, sizeof took, "%.0f s for the %d together", elapsed, together);
@@ -445,9 +446,7 @@ int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_
     search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = sizeof err};
     int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t) * cal_tier_beds(t);
     free(r);
-    const cal_tier *map = t->map_tier ? cal_config_tier_named(c, t->map_tier) : NULL;
-    int map_runs = map && runs >= 0 ? cal_friction_planned_runs(c, map, angles, areas, material) : 0;
-    return map_runs < 0 ? -1 : runs + map_runs;
+    return runs;
 }
 
 // The stage's search with its targets set: what a one-tier stage and the

@@ -122,7 +122,12 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
 {
     const cal_tier *map_tier = cal_config_tier_named(c, t->map_tier); // checked on loading
     fprintf(stderr, "-- map: the whole search at tier '%s' (lambda %g)\n", map_tier->name, map_tier->lambda);
-    if (cal_stage_friction(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len)) return 1;
+    env->mapping = 1; // progress: "NAME (map)", counted as map-tier drum runs
+    int bad = cal_stage_friction(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len);
+    env->mapping = 0;
+    if (bad) return 1;
+    cal_env_set_stage(env, material ? material->name : "granule");
+    cal_progress_enter(env->progress, env->stage);
     two_tier tt = {.r = out};
     tt.search = cal_friction_begin(env, c, t, angles, areas, k_n, material, gg_mu_s, gg_mu_r, out, err, len);
     if (!tt.search) return 1;
@@ -130,6 +135,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     int n_y = n_measurements(out);
     snprintf(out->map_tier, sizeof out->map_tier, "%s", map_tier->name);
     out->map_candidates = cheap->n, out->map_wall_time_s = cheap->wall_time_s;
+    out->map_simulations = cheap->simulations, out->map_core_s = cheap->core_s;
     out->nlopt_result = "NLopt BOBYQA on the corrected map (two tiers)";
     cal_mf_map map;
     if (n_y > CAL_MF_MAX_Y || fit_map(cheap, tt.bounds, n_y, &map)) {

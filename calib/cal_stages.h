@@ -95,12 +95,16 @@ typedef struct cal_friction_result {
     int identified_count;               ///< candidates within the threshold
     const char *nlopt_result;
     double wall_time_s;
+    int simulations;                    ///< drum runs of this tier's candidates (stored ones included)
+    double core_s;                      ///< what they cost, single-core seconds (their records' costs)
     /// Two-tier stage (tier with map_tier): the cheap tier, its runs and
     /// cost, the correction measured (angle, then CSA per speed), and how the
     /// loop ended. map_tier[0] == 0: a one-tier stage.
     char map_tier[32];
     int map_candidates, expensive_candidates;
     double map_wall_time_s;
+    int map_simulations;                ///< the map tier's drum runs, and their single-core seconds
+    double map_core_s;
     double correction[CAL_MAX_RPM + 1];
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
@@ -122,9 +126,11 @@ int cal_friction_best(const cal_friction_result *r);
 /// tell from the best; μs and μr range over those. Needs csa_tier_sd set.
 void cal_friction_identify(cal_friction_result *r);
 
-/// The drum runs stage 2 (material == NULL) or 3 may take at most: its
-/// speeds times (grid points + COBYLA's evaluations + bound probes); -1 if
-/// the data lack the stage's surface (the stage itself then says why).
+/// The drum runs stage 2 (material == NULL) or 3 may take at tier t at most:
+/// its speeds times beds times (grid points + COBYLA's evaluations + bound
+/// probes), or with a map tier times its max_evaluations (the map tier's
+/// runs are its own plan); -1 if the data lack the stage's surface (the stage
+/// itself then says why).
 int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
                               const cal_series *areas, const cal_material *material);
 

@@ -56,6 +56,26 @@ static void test_time_left_from_measured_costs(void **state)
     assert_float_equal(cal_progress_eta_s(&p), 17 * 200.0 / 2, 1e-9);
 }
 
+// A two-tier stage: the map tier's runs cost their own (10 s), the tier's
+// own runs theirs (300 s); one cost for both would put the ETA 30x off.
+static void test_map_tier_runs_have_their_own_cost(void **state)
+{
+    (void)state;
+    cal_progress p;
+    char text[200];
+    cal_progress_init(&p, 1);
+    assert_int_equal(cal_progress_plan(&p, "granule (map)", CAL_RUN_MAP_DRUM, 20), 0);
+    assert_int_equal(cal_progress_plan(&p, "granule", CAL_RUN_DRUM, 6), 0);
+    cal_progress_enter(&p, "granule (map)");
+    for (int k = 0; k < 20; ++k) cal_progress_count(&p, CAL_RUN_MAP_DRUM, 10);
+    assert_true(isnan(cal_progress_eta_s(&p))); // the tier's own runs have no cost yet
+    cal_progress_describe(&p, text, sizeof text);
+    assert_string_equal(text, "step 1 of 2 (granule (map)), 20 of ≤ 26 simulations, time left after the first drum run");
+    cal_progress_enter(&p, "granule");
+    cal_progress_count(&p, CAL_RUN_DRUM, 300);
+    assert_float_equal(cal_progress_eta_s(&p), 5 * 300.0, 1e-9);
+}
+
 static void test_a_stage_ended_early_leaves_nothing(void **state)
 {
     (void)state;
@@ -90,6 +110,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_no_time_left_before_a_cost),
                                        cmocka_unit_test(test_time_left_from_measured_costs),
+        cmocka_unit_test(test_map_tier_runs_have_their_own_cost),
                                        cmocka_unit_test(test_a_stage_ended_early_leaves_nothing),
                                        cmocka_unit_test(test_unplanned_and_null)};
     return cmocka_run_group_tests(tests, NULL, NULL);
