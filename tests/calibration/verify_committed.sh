@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Verifies a committed calibration from its own store (issue 22):
+#  1. the table re-derived from the committed store, by the calibration's own command (report.md),
+#     is the committed calibrated_parameters.csv byte for byte, and no simulation runs;
+#  2. N of the simulations that command used, picked at random (the pick's seed is printed: rerun
+#     with SEED=... to repeat it), are removed from a copy of the store and run again; each must
+#     reproduce its committed record's measurements exactly (one thread a simulation: the engine is
+#     deterministic, and its results do not depend on the CPU), and the table must come out the same.
+#   usage: verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
+# RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
+# files, and, for a run made with --data, the data files it read.
+set -euo pipefail
+bin=$1 src=$2 results=$3 work=$4 n=${5:-2}
+rm -rf "$work" && mkdir -p "$work/out"
+command=$(sed -n 's/^Command: `\(.*\)`.*/\1/p' "$results/report.md")
+[ -n "$command" ] || { echo "FAIL: no Command: line in $results/report.md"; exit 1; }
+read -r -a words <<< "$command"
+# The same command, its results folder here and its data the committed copies.
+args=() stage=all
+for ((i = 2; i < ${#words[@]}; ++i)); do # words[0..1]: granucal calibrate
+  case ${words[i]} in
+    --out) i=$((i + 1)); args+=(--out "$work/out") ;;
+    --data) i=$((i + 1)); args+=(--data "$results") ;;
+    --jobs) i=$((i + 1)) ;;
+    --stage) stage=${words[i + 1]}; args+=("${words[i]}") ;;
+    *) args+=("${words[i]}") ;;
+  esac
+done
+grep -q -- "--out" <<< "${args[*]}" || args+=(--out "$work/out")
+cp -r "$results/store" "$work/out/"
+cp "$results"/stage_*.yaml "$work/out/" 2>/dev/null || true
+run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs 1 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
+ran() { sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/$1.log"; }
+fails=0
+
+echo "re-deriving: granucal calibrate ${args[*]}"
+run derive
+[ "$(ran derive)" = 0 ] || { echo "FAIL: re-deriving ran $(ran derive) simulations (the store is incomplete)"; fails=$((fails + 1)); }
+if cmp -s "$results/calibrated_parameters.csv" "$work/out/calibrated_parameters.csv"; then
+  echo "ok   the table re-derived from the store is the committed one, byte for byte"
+else
+  echo "FAIL: the re-derived table differs:"; diff "$results/calibrated_parameters.csv" "$work/out/calibrated_parameters.csv" || true
+  fails=$((fails + 1))
+fi
+
+# The drum records this command's stages used (simulations.csv: stage, candidate, record, experiment, ...).
+case $stage in
+  granule) keep='$1 == "granule"' ;;
+  wall) keep='$1 != "granule" && $1 != "stiffness"' ;;
+  *) keep='1' ;;
+esac
+seed=${SEED:-$(date +%s)}
+mapfile -t picked < <(awk -F, "NR > 1 && \$4 == \"drum\" && ($keep) { print \$3 }" "$results/simulations.csv" | sort -u |
+  shuf -n "$n" --random-source=<(yes "$seed"))
+echo "picked at random (SEED=$seed): ${picked[*]}"
+[ "${#picked[@]}" -eq "$n" ] || { echo "FAIL: fewer than $n drum records to pick from"; exit 1; }
+for h in "${picked[@]}"; do rm "$work/out/store/$h.yaml"; done
+run rerun
+[ "$(ran rerun)" = "$n" ] || { echo "FAIL: the rerun ran $(ran rerun) simulations, not $n"; fails=$((fails + 1)); }
+fields='^(key|status|angle_deg|angle_sd_deg|csa_percent|csa_sd_percent|steady|simulated_time_s|dt_s|particle_steps|granules|dt_margin_min|dt_lowered):'
+for h in "${picked[@]}"; do
+  if diff <(grep -E "$fields" "$results/store/$h.yaml") <(grep -E "$fields" "$work/out/store/$h.yaml") > "$work/$h.diff"; then
+    echo "ok   $h reproduced: $(grep -E '^(angle_deg|csa_percent):' "$work/out/store/$h.yaml" | tr '\n' ' ')"
+  else
+    echo "FAIL: $h not reproduced:"; cat "$work/$h.diff"; fails=$((fails + 1))
+  fi
+done
+cmp -s "$results/calibrated_parameters.csv" "$work/out/calibrated_parameters.csv" ||
+  { echo "FAIL: the table after the reruns differs"; fails=$((fails + 1)); }
+echo "$fails failure(s)"
+exit $((fails > 0))
