@@ -61,6 +61,8 @@ static const char help[] =
     "  --jobs N           simulations side by side on this machine (default: cores)\n"
     "  --checkpoint-every S  wall seconds between a drum run's checkpoints (default 120;\n"
     "                     0: none)\n"
+    "  --budget-hours H   refuse, before the first simulation, a plan predicted to take\n"
+    "                     longer than H hours of wall time\n"
     "  -h, --help         this text\n"
     "\n"
     "Progress: one line per simulation on stderr, ending with the step of the whole\n"
@@ -84,6 +86,7 @@ typedef struct options {
     const char *config, *tier, *stage, *material, *out, *data;
     int jobs;
     double checkpoint_every_s;
+    double budget_hours; ///< refuse a plan predicted to take longer (NAN: no limit)
 } options;
 
 static int parse_options(int argc, char **argv, options *o)
@@ -91,8 +94,10 @@ static int parse_options(int argc, char **argv, options *o)
     static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
                                           {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
                                           {"checkpoint-every", 1, 0, 'c'}, {"data", 1, 0, 'd'},
+                                          {"budget-hours", 1, 0, 'b'},
                                           {0, 0, 0, 0}};
-    *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
+    *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S,
+                   .budget_hours = NAN};
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     o->jobs = ncpu > 0 ? (int)ncpu : 1;
     int c;
@@ -105,6 +110,10 @@ static int parse_options(int argc, char **argv, options *o)
         case 'm': o->material = optarg, o->stage = "wall"; break;
         case 'o': o->out = optarg; break;
         case 'd': o->data = optarg; break;
+        case 'b':
+            if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
+                return fprintf(stderr, "granucal calibrate: --budget-hours '%s': expected a number of hours > 0\n", optarg), 2;
+            break;
         case 'j':
             if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024))
                 return fprintf(stderr, "granucal calibrate: --jobs '%s': expected a whole number in 1..1024\n", optarg), 2;
@@ -213,6 +222,11 @@ typedef struct run {
     char err[2048];
 } run;
 
+static void plan_progress(run *r);
+static int check_predicted_cost(run *r);
+
+// Everything checked, the plan predicted, then the results folder made: a
+// refused run leaves nothing behind.
 static int prepare(run *r)
 {
     char path[1200];
@@ -232,6 +246,9 @@ static int prepare(run *r)
         found |= r->opt.material && strcasecmp(r->opt.material, r->c->materials[k].name) == 0;
     }
     if (!found) return exp_fail(r->err, sizeof r->err, "--material '%s': not under materials in %s", r->opt.material, r->c->path);
+    r->env.workers = r->opt.jobs;
+    plan_progress(r);
+    if (check_predicted_cost(r)) return 1;
     if (r->opt.out) snprintf(r->out, sizeof r->out, "%s", r->opt.out);
     else {
         char stem[1024];
@@ -367,6 +384,47 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
     cal_progress_plan(&r->progress, name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
 }
 
+// Particle-steps a second on one core: the kernel and a whole drum run
+// measured 8.3-9.0e6 on this project's 2-core machine
+// (results/benchmarks/drum_end_to_end.md); a prediction, not a promise.
+static const double predicted_rate = 8.5e6;
+
+// The drum runs the plan may take, predicted before the first one: core-hours,
+// wall hours on the workers, one simulation's memory. A plan that cannot fit
+// the memory left, or the --budget-hours given, is refused with these numbers.
+static int check_predicted_cost(run *r)
+{
+    double core_s = 0, memory_mb = 0;
+    int runs = 0;
+    for (int k = 0; k < r->progress.n_stages; ++k) {
+        const cal_progress_stage *s = &r->progress.stage[k];
+        const cal_tier *t = s->kind == CAL_RUN_MAP_DRUM ? cal_config_tier_named(r->c, r->t->map_tier)
+                            : s->kind == CAL_RUN_DRUM   ? r->t
+                                                        : NULL;
+        if (!t) continue; // stage 1's cylinders: small beside the drum runs
+        cal_drum_case d = cal_drum_case_granule(r->c, t, r->c->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
+        exp_drum_cost c = exp_drum_predict_cost(&d.def, t->max_time);
+        int speeds = t->rpm_count > 0 ? (int)t->rpm_count : 5; // a bed settles once for its speeds
+        core_s += (s->planned * c.turn_particle_steps + (double)s->planned / speeds * c.fill_particle_steps) / predicted_rate;
+        memory_mb = fmax(memory_mb, c.memory_mb), runs += s->planned;
+    }
+    int parallel = r->env.workers * cal_mpi_size();
+    double wall_h = core_s / 3600 / (parallel < runs ? parallel : runs > 0 ? runs : 1);
+    char what[256];
+    snprintf(what, sizeof what, "at most %d drum runs, predicted %.2g core-hours (%.2g h on %d worker(s)), %.0f MB a run",
+             runs, core_s / 3600, wall_h, parallel, memory_mb);
+    fprintf(stderr, "== plan: %s\n", what);
+    long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    double free_mb = pages > 0 && page > 0 ? (double)pages * (double)page / 1048576 : INFINITY;
+    if (memory_mb * r->env.workers > free_mb)
+        return exp_fail(r->err, sizeof r->err, "tier '%s': %s; %d at once need more than the %.0f MB free: use fewer --jobs "
+                        "or a coarser tier", r->t->name, what, r->env.workers, free_mb);
+    if (wall_h > r->opt.budget_hours)
+        return exp_fail(r->err, sizeof r->err, "tier '%s': %s, over --budget-hours %g: nothing was run", r->t->name, what,
+                        r->opt.budget_hours);
+    return 0;
+}
+
 // Every stage this run will do, with the simulations it may take, so that
 // progress lines can say how far the whole calibration is and the time left.
 static void plan_progress(run *r)
@@ -387,7 +445,6 @@ static int calibrate(run *r, const char *command)
     double k_n, gg_mu_s, gg_mu_r;
     const char *k_source, *gg_source;
     r->env.started = exp_wall_seconds();
-    plan_progress(r);
     r->table.gg_mu_s_range = r->table.gg_mu_r_range = CAL_NO_RANGE; // until stage 2 says
     if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
         stage_walls(r, k_n, gg_mu_s, gg_mu_r))

@@ -65,6 +65,23 @@ int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);
 /// how loosely the contact parameters let the bed pack. NULL with a message.
 dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *ctx, char *err, size_t len);
 
+/// What a drum run is expected to cost, before it runs (for refusing a tier
+/// that cannot fit the machine or the budget): granules from the bed volume at
+/// a poured solid fraction of 0.6; the steps from eq. 14's dt_crit of the
+/// lightest scaled granule at the fractions the engine runs (0.165 filling:
+/// the a-priori FCC bound; 0.30 turning: a settled bed's network, measured
+/// 0.29-0.30 at λ 4096 and 1000, results/benchmarks/drum_end_to_end.md); the
+/// fill charged 1.25 s of simulated time (measured 1.20-1.25 s there).
+typedef struct exp_drum_cost {
+    double granules;
+    double fill_particle_steps;     ///< pouring and settling one bed
+    double turn_particle_steps;     ///< one speed turned for max_time
+    double memory_mb;               ///< one simulation's peak resident memory
+} exp_drum_cost;
+
+/// The expected cost of settling d's bed and turning it for max_time s.
+exp_drum_cost exp_drum_predict_cost(const exp_drum_def *d, double max_time);
+
 /// Measure the drum face: angle of the free surface and occupied CSA.
 typedef struct exp_drum_measure {
     double angle_deg;        ///< magnitude of the surface angle (the dynamic angle of repose)

@@ -65,6 +65,8 @@ expect "extra fields, angle file" "extra_angle.csv:2: row: has 7 fields, expecte
 expect "extra fields, CSA file" "extra_csa.csv:3: row: has 7 fields, expected 4" -- "$(csa extra_csa '# lab\nsurface,rpm,csa_percent,csa_sd_percent\nPTFE,4,45,0.5,1,2,3\nPTFE,40,50,0.5\n')" "${out[@]}"
 expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
 expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
+expect "a plan over the budget" "over --budget-hours 0.001: nothing was run" -- "$work/configs/good.yaml" --tier ci --budget-hours 0.001 "${out[@]}"
+expect "a budget not a number" "--budget-hours 'soon'" -- "$work/configs/good.yaml" --budget-hours soon "${out[@]}"
 expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
 expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
 # granucal synthesize (twin data): pairs and beds checked before the first run.
