@@ -409,7 +409,7 @@ static void report_two_tier(FILE *f, const cal_friction_result *r)
     int predicted = 0;
     for (int i = 0; i < r->n; ++i) predicted += r->cand[i].predicted;
     fprintf(f, "Two tiers: tier '%s' mapped the plane (%d candidates, %.0f s); this tier ran %d candidate(s) where the "
-               "corrected map put the optimum (%.0f s with the map). Outcome: %s. The correction measured between the "
+               "corrected map put the optimum (%.0f s). Outcome: %s. The correction measured between the "
                "tiers (this tier minus the map): angle %+.2f°",
             r->map_tier, r->map_candidates, r->map_wall_time_s, r->expensive_candidates, r->wall_time_s,
             r->two_tier_outcome ? r->two_tier_outcome : "not run", r->correction[0]);
