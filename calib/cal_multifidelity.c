@@ -30,8 +30,9 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
         for (int i = 0; i < n; ++i) gsl_vector_set(y, (size_t)i, pts[i].y[k]);
         double chisq;
         size_t rank;
-        // Truncated SVD: points on a line (a 1-D set of candidates) leave
-        // the cross terms undetermined, and those are set to 0, not to noise.
+        // Truncated SVD: directions the points do not span (a nearly
+        // singular design) are dropped rather than inverted into noise; a
+        // design of rank below 3 (points on a line) is refused.
         bad = gsl_multifit_linear_tsvd(X, y, 1e-10, c, cov, &chisq, &rank, work) != 0 || rank < 3;
         for (int j = 0; j < p && !bad; ++j) map->coef[k][j] = gsl_vector_get(c, (size_t)j);
         map->rms[k] = sqrt(chisq / n);
