@@ -108,7 +108,6 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
     k->objective = r->angle_in_misfit ? (angle_z2(r, k) + sum) / (r->n_rpm + 1) : k->misfit;
 }
 
-// The candidate's measurements from its records, then its scores.
 // Speed j's measurement averaged over the candidate's beds (rec: beds ×
 // n_sim records, by bed): the angle over the usable runs, the CSA over the
 // usable and steady ones; NAN where none is.
@@ -131,6 +130,7 @@ static bed_mean mean_over_beds(const search *s, const cal_record *rec, int j)
     return m;
 }
 
+// The candidate's measurements from its records (the mean over its beds), then its scores.
 static void score(search *s, cal_candidate *k, const cal_record *rec)
 {
     cal_friction_result *r = s->r;
@@ -340,7 +340,6 @@ void cal_friction_identify(cal_friction_result *r)
     }
     r->mu_s_range = range_of(r, 0), r->mu_r_range = range_of(r, 1);
 }
-
 
 static const char *run_cobyla(search *s)
 {
