@@ -296,13 +296,14 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
 
 // ---- every simulation ------------------------------------------------------------
 
-// Candidate i's records on bed b, one row a speed (the stage's own records:
-// a two-tier stage's predicted candidates are the map tier's runs).
-static void bed_simulations(FILE *f, const cal_outcome *o, const cal_friction_result *r, int i, int b, const char *store)
+// Candidate i's records on bed b of tier t, one row a speed.
+static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, const cal_friction_result *r, int i, int b,
+                            const char *store)
 {
-    const char *stage = r->material[0] ? r->material : "granule";
+    char stage[48];
+    snprintf(stage, sizeof stage, "%s%s", r->material[0] ? r->material : "granule", t != o->tier ? " (map)" : "");
     const cal_candidate *k = &r->cand[i];
-    cal_drum_case dc = cal_friction_case(o->config, o->tier, r, k->mu_s, k->mu_r, b);
+    cal_drum_case dc = cal_friction_case(o->config, t, r, k->mu_s, k->mu_r, b);
     double rpm[CAL_MAX_RPM + 1];
     int n = r->n_rpm;
     memcpy(rpm, r->rpm, sizeof(double) * (size_t)n);
@@ -323,10 +324,16 @@ static void bed_simulations(FILE *f, const cal_outcome *o, const cal_friction_re
     }
 }
 
+// A stage's simulations: its own candidates', and in a two-tier stage the map
+// tier's, found through the predicted candidates that stand for them (a map
+// candidate with a failed speed has none, and is not listed).
 static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store)
 {
-    for (int i = 0; i < r->n; ++i)
-        for (int b = 0; b < cal_tier_beds(o->tier) && !r->cand[i].predicted; ++b) bed_simulations(f, o, r, i, b, store);
+    const cal_tier *map = o->tier->map_tier ? cal_config_tier_named(o->config, o->tier->map_tier) : NULL;
+    for (int i = 0; i < r->n; ++i) {
+        const cal_tier *t = r->cand[i].predicted ? map : o->tier;
+        for (int b = 0; t && b < cal_tier_beds(t); ++b) bed_simulations(f, o, t, r, i, b, store);
+    }
 }
 
 static int write_simulations(const char *dir, const char *store, const cal_outcome *o, char *err, size_t len)

@@ -2,12 +2,13 @@
 # A calibration killed with SIGKILL at 5 different points, then run again with the same
 # command, completes with the same table as an uninterrupted run, reruns nothing already
 # stored, and never leaves a damaged file.
-#   usage: kill_resume.sh GRANUCAL SOURCE_DIR WORK_DIR
+#   usage: kill_resume.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]   (TIER: check; check-two-tier for the
+#   two-tier search, whose map tier's runs are part of the same store and the same table)
 set -euo pipefail
-bin=$1 src=$2 work=$3
+bin=$1 src=$2 work=$3 tier=${4:-check}
 rm -rf "$work" && mkdir -p "$work"
 cd "$src"
-args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 2)
+args=(calibrate configs/calibration.yaml --tier "$tier" --material PTFE --jobs 2)
 "$bin" "${args[@]}" --out "$work/whole" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
 total=$(($(wc -l < "$work/whole/simulations.csv") - 1))
 # Stored = a record a rerun keeps: not one marking a worker killed from outside (retry: true),
