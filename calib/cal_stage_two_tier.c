@@ -155,6 +155,9 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
     out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
     for (int k = 0; k < n_y; ++k) out->correction[k] = m->delta[k];
+    for (int i = 0; i < m->n; ++i) // what each run measured against what the corrected map said before it
+        fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
+                t->name, m->run[i].y[0], m->predicted[i][0]);
     fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction: angle %+.2f°\n", out->two_tier_outcome, m->n, t->name,
             m->delta[0]);
     if (!m->failed && m->n > 0) add_predicted(out, cheap, m->delta);
