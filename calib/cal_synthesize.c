@@ -292,27 +292,28 @@ static void write_header(FILE *f, const job *j, const char *what, const char *co
     fprintf(f, "; spread = standard error of that mean (floor 0.05).\n# Made by: %s\n", command);
 }
 
-static int write_files(job *j, const lining_result *res, const char *command)
+// One data file: the angle at the angle's speed, or the CSA at every speed
+// (the schemas of cal_data.h).
+static int write_series(job *j, const lining_result *res, const char *command, int angle)
 {
     char path[1200];
     cal_atomic_file a;
-    snprintf(path, sizeof path, "%s/repose_angle.csv", j->out);
+    snprintf(path, sizeof path, "%s/%s", j->out, angle ? "repose_angle.csv" : "occupied_area.csv");
     if (cal_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
-    write_header(a.f, j, "Dynamic angle of repose", command);
-    fputs("surface,rpm,angle_deg,angle_sd_deg\n", a.f);
+    write_header(a.f, j, angle ? "Dynamic angle of repose" : "Occupied cross-section area (eq. 20)", command);
+    fputs(angle ? "surface,rpm,angle_deg,angle_sd_deg\n" : "surface,rpm,csa_percent,csa_sd_percent\n", a.f);
     for (int l = 0; l < j->n_linings; ++l)
-        for (int k = 0; k < j->n_rpm; ++k)
-            if (j->rpm[k] == j->angle_rpm)
-                fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], res[l].angle[k].mean, spread_of(res[l].angle[k]));
-    if (cal_atomic_commit(&a, j->err, sizeof j->err)) return 1;
-    snprintf(path, sizeof path, "%s/occupied_area.csv", j->out);
-    if (cal_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
-    write_header(a.f, j, "Occupied cross-section area (eq. 20)", command);
-    fputs("surface,rpm,csa_percent,csa_sd_percent\n", a.f);
-    for (int l = 0; l < j->n_linings; ++l)
-        for (int k = 0; k < j->n_rpm; ++k)
-            fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], res[l].csa[k].mean, spread_of(res[l].csa[k]));
+        for (int k = 0; k < j->n_rpm; ++k) {
+            if (angle && j->rpm[k] != j->angle_rpm) continue;
+            summary v = angle ? res[l].angle[k] : res[l].csa[k];
+            fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], v.mean, spread_of(v));
+        }
     return cal_atomic_commit(&a, j->err, sizeof j->err);
+}
+
+static int write_files(job *j, const lining_result *res, const char *command)
+{
+    return write_series(j, res, command, 1) || write_series(j, res, command, 0);
 }
 
 static int prepare(job *j)
