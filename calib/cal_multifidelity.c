@@ -44,12 +44,17 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
     return 0;
 }
 
-void cal_mf_predict(const cal_mf_map *map, const double *delta, double u, double v, double *y)
+void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, double *y)
+{
+    for (int k = 0; c && k < n_y; ++k) y[k] += c->at[k] + c->du[k] * (u - c->u0) + c->dv[k] * (v - c->v0);
+}
+
+void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y)
 {
     double x[CAL_MF_TERMS];
     terms(u, v, x);
     for (int k = 0; k < map->n_y; ++k) {
-        double sum = delta ? delta[k] : 0;
+        double sum = 0;
         for (int j = 0; j < map->n_terms; ++j) sum += map->coef[k][j] * x[j];
         y[k] = sum;
     }
@@ -57,7 +62,7 @@ void cal_mf_predict(const cal_mf_map *map, const double *delta, double u, double
 
 typedef struct corrected {
     const cal_mf_map *map;
-    const double *delta;
+    const cal_mf_correction *correction;
     const cal_mf_problem *p;
 } corrected;
 
@@ -66,13 +71,15 @@ static double corrected_objective(unsigned n, const double *x, double *grad, voi
     (void)n, (void)grad;
     const corrected *c = ctx;
     double y[CAL_MF_MAX_Y];
-    cal_mf_predict(c->map, c->delta, x[0], x[1], y);
+    cal_mf_predict(c->map, x[0], x[1], y);
+    cal_mf_correct(c->correction, c->map->n_y, x[0], x[1], y);
     return c->p->objective(y, c->p->ctx);
 }
 
-void cal_mf_optimum(const cal_mf_map *map, const double *delta, const cal_mf_problem *p, double *u, double *v)
+void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *correction, const cal_mf_problem *p, double *u,
+                    double *v)
 {
-    corrected c = {map, delta, p};
+    corrected c = {map, correction, p};
     enum { SCAN = 41 };
     double x[2] = {0.5, 0.5}, best = INFINITY;
     // The map is a smooth surface but the objective of it need not be convex
@@ -117,20 +124,52 @@ static int measured(const cal_mf_point *p, int n_y)
     return 1;
 }
 
-// The correction: the mean over the expensive runs that measured everything
-// of (run - cheap map); a run with a missing measurement says nothing of it.
-static void update_delta(const cal_mf_map *cheap, cal_mf_result *r, int n_y)
+// A least-squares slope from the centred sums of squares and cross products.
+static double slope(double sxx, double sxd) { return sxx > 0 ? sxd / sxx : 0; }
+
+// The correction: the discrepancy (run - cheap map) of the runs that measured
+// everything, its mean at their centre and, with three runs or more, its
+// slopes along each direction they span (least squares on the centred
+// coordinates: both at once where both are spanned).
+static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, int n_y)
 {
-    double sum[CAL_MF_MAX_Y] = {0};
+    enum { MIN_RUNS_FOR_SLOPES = 3 };
+    const double min_span = 0.05;
+    double d[CAL_MF_MAX_FINE][CAL_MF_MAX_Y], u[CAL_MF_MAX_FINE], v[CAL_MF_MAX_FINE];
     int m = 0;
     for (int i = 0; i < r->n; ++i) {
         if (!measured(&r->run[i], n_y)) continue;
         double y[CAL_MF_MAX_Y];
-        cal_mf_predict(cheap, NULL, r->run[i].u, r->run[i].v, y);
-        for (int k = 0; k < n_y; ++k) sum[k] += r->run[i].y[k] - y[k];
-        m++;
+        cal_mf_predict(cheap, r->run[i].u, r->run[i].v, y);
+        for (int k = 0; k < n_y; ++k) d[m][k] = r->run[i].y[k] - y[k];
+        u[m] = r->run[i].u, v[m] = r->run[i].v, m++;
     }
-    for (int k = 0; k < n_y; ++k) r->delta[k] = m ? sum[k] / m : 0;
+    cal_mf_correction *c = &r->correction;
+    memset(c, 0, sizeof *c);
+    if (m == 0) return;
+    double u_lo = u[0], u_hi = u[0], v_lo = v[0], v_hi = v[0];
+    for (int i = 0; i < m; ++i) {
+        c->u0 += u[i] / m, c->v0 += v[i] / m;
+        u_lo = fmin(u_lo, u[i]), u_hi = fmax(u_hi, u[i]), v_lo = fmin(v_lo, v[i]), v_hi = fmax(v_hi, v[i]);
+    }
+    int use_u = m >= MIN_RUNS_FOR_SLOPES && u_hi - u_lo >= min_span;
+    int use_v = m >= MIN_RUNS_FOR_SLOPES && v_hi - v_lo >= min_span;
+    double suu = 0, svv = 0, suv = 0;
+    for (int i = 0; i < m; ++i) {
+        double x = u[i] - c->u0, z = v[i] - c->v0;
+        suu += x * x, svv += z * z, suv += x * z;
+    }
+    double det = suu * svv - suv * suv;
+    if (use_u && use_v && !(det > 1e-12 * suu * svv)) use_u = use_v = 0; // runs on a slanted line: the mean only
+    for (int k = 0; k < n_y; ++k) {
+        double sd = 0, sud = 0, svd = 0;
+        for (int i = 0; i < m; ++i) sd += d[i][k];
+        c->at[k] = sd / m;
+        for (int i = 0; i < m; ++i) sud += (u[i] - c->u0) * (d[i][k] - c->at[k]), svd += (v[i] - c->v0) * (d[i][k] - c->at[k]);
+        if (use_u && use_v) c->du[k] = (svv * sud - suv * svd) / det, c->dv[k] = (suu * svd - suv * sud) / det;
+        else if (use_u) c->du[k] = slope(suu, sud);
+        else if (use_v) c->dv[k] = slope(svv, svd);
+    }
 }
 
 int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out)
@@ -140,15 +179,18 @@ int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_resul
     int budget = p->max_expensive < CAL_MF_MAX_FINE ? p->max_expensive : CAL_MF_MAX_FINE;
     while (out->n < budget) {
         double u, v;
-        cal_mf_optimum(cheap, out->delta, p, &u, &v);
+        cal_mf_optimum(cheap, &out->correction, p, &u, &v);
         if (already_run(out, u, v)) return out->settled = 1, 0;
         cal_mf_point *run = &out->run[out->n];
         run->u = u, run->v = v;
-        cal_mf_predict(cheap, out->delta, u, v, out->predicted[out->n]);
+        cal_mf_predict(cheap, u, v, out->predicted[out->n]);
+        cal_mf_correct(&out->correction, p->n_y, u, v, out->predicted[out->n]);
         if (p->run_expensive(u, v, run->y, p->ctx)) return out->failed = 1, 0;
         out->agreed = agrees(run->y, out->predicted[out->n], p);
         out->n++;
-        update_delta(cheap, out, p->n_y);
+        update_correction(cheap, out, p->n_y);
+        memset(out->delta, 0, sizeof out->delta);
+        cal_mf_correct(&out->correction, p->n_y, u, v, out->delta);
         if (out->agreed) return 0;
     }
     return 0;

@@ -5,8 +5,9 @@
 /// a quadratic least-squares surface through those points is the map. The
 /// expensive (converged) tier is run only where the map says the optimum is,
 /// and at each such point the program measures the discrepancy between the
-/// two tiers; the map, corrected by the mean discrepancy so far (one additive
-/// correction per measurement), gives the next optimum. The search ends when
+/// two tiers; the map, corrected by the discrepancy so far (per measurement:
+/// its mean, and once three runs span a direction of the plane, its slope
+/// along it, by least squares), gives the next optimum. The search ends when
 /// an expensive run agrees with what the corrected map predicted for it
 /// within the data's noise, or its budget of expensive runs is spent.
 ///
@@ -37,8 +38,19 @@ typedef struct cal_mf_map {
 /// fitted) with fewer or a singular design.
 int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map);
 
-/// The map at (u, v) plus `delta` (NULL: none).
-void cal_mf_predict(const cal_mf_map *map, const double *delta, double u, double v, double *y);
+/// The map at (u, v).
+void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y);
+
+/// The measured discrepancy between the tiers, per measurement: its value
+/// at (u0, v0), the runs' centre, and its slopes along u and v (0 along a
+/// direction the runs do not span by 0.05, or with fewer than three runs).
+typedef struct cal_mf_correction {
+    double at[CAL_MF_MAX_Y], du[CAL_MF_MAX_Y], dv[CAL_MF_MAX_Y];
+    double u0, v0;
+} cal_mf_correction;
+
+/// Add the correction at (u, v) to y (n_y measurements); c NULL: nothing.
+void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, double *y);
 
 /// What the stage gives the loop.
 typedef struct cal_mf_problem {
@@ -58,7 +70,8 @@ typedef struct cal_mf_result {
     int n;                                   ///< expensive runs made
     cal_mf_point run[CAL_MF_MAX_FINE];       ///< where, and what they measured
     double predicted[CAL_MF_MAX_FINE][CAL_MF_MAX_Y]; ///< what the corrected map said before each run
-    double delta[CAL_MF_MAX_Y];              ///< the correction after the last run (mean discrepancy)
+    cal_mf_correction correction;            ///< after the last run
+    double delta[CAL_MF_MAX_Y];              ///< that correction at the last run's point
     int agreed;                              ///< 1: the last run agreed with its prediction
     int settled;                             ///< 1: the next optimum was a point already run (stopped there)
     int failed;                              ///< 1: an expensive run failed
@@ -72,6 +85,6 @@ int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_resul
 
 /// The corrected map's optimum over the unit square (a 41 × 41 scan, then
 /// NLopt BOBYQA from its best point).
-void cal_mf_optimum(const cal_mf_map *map, const double *delta, const cal_mf_problem *p, double *u, double *v);
+void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *c, const cal_mf_problem *p, double *u, double *v);
 
 #endif

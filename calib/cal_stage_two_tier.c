@@ -9,8 +9,8 @@
 // What the stage reports: the chosen pair is the best candidate run at this
 // tier; the identified ranges are over those and over every map candidate
 // corrected by the measured discrepancy (their measurements at the map tier
-// plus the correction, marked "predicted"), since a handful of expensive
-// runs alone would say nothing about the range.
+// plus the correction where they stand, marked "predicted"), since a handful
+// of expensive runs alone would say nothing about the range.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -92,13 +92,15 @@ static int fit_map(const cal_friction_result *cheap, const cal_bounds *b, int n_
     return bad;
 }
 
-// Every usable map candidate, corrected, as a predicted candidate of this stage.
-static void add_predicted(cal_friction_result *r, const cal_friction_result *cheap, const double *delta)
+// Every usable map candidate, corrected where it stands, as a predicted candidate of this stage.
+static void add_predicted(cal_friction_result *r, const cal_friction_result *cheap, const cal_bounds *b,
+                          const cal_mf_correction *correction)
 {
     for (int i = 0; i < cheap->n && r->n < CAL_MAX_EVALS; ++i) {
-        double y[CAL_MF_MAX_Y];
+        double y[CAL_MF_MAX_Y], u, v;
         if (vector_of(cheap, &cheap->cand[i], y)) continue;
-        for (int k = 0; k < n_measurements(r); ++k) y[k] += delta[k];
+        cal_friction_to_unit(b, cheap->cand[i].mu_s, cheap->cand[i].mu_r, &u, &v);
+        cal_mf_correct(correction, n_measurements(r), u, v, y);
         cal_candidate *k = &r->cand[r->n++];
         memset(k, 0, sizeof *k);
         k->mu_s = cheap->cand[i].mu_s, k->mu_r = cheap->cand[i].mu_r;
@@ -158,9 +160,9 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     for (int i = 0; i < m->n; ++i) // what each run measured against what the corrected map said before it
         fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
                 t->name, m->run[i].y[0], m->predicted[i][0]);
-    fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction: angle %+.2f°\n", out->two_tier_outcome, m->n, t->name,
-            m->delta[0]);
-    if (!m->failed && m->n > 0) add_predicted(out, cheap, m->delta);
+    fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction at the last run: angle %+.2f°\n", out->two_tier_outcome,
+            m->n, t->name, m->delta[0]);
+    if (!m->failed && m->n > 0) add_predicted(out, cheap, tt.bounds, &m->correction);
     free(m);
     return cal_friction_finish(tt.search);
 }

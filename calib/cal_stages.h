@@ -105,7 +105,7 @@ typedef struct cal_friction_result {
     double map_wall_time_s;
     int map_simulations;                ///< the map tier's drum runs, and their single-core seconds
     double map_core_s;
-    double correction[CAL_MAX_RPM + 1];
+    double correction[CAL_MAX_RPM + 1]; ///< at the last run (cal_mf_result.delta)
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
 } cal_friction_result;
