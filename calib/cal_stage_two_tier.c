@@ -118,6 +118,23 @@ static const char *outcome_of(const cal_mf_result *m)
     return "stopped at max_evaluations without agreeing with the corrected map";
 }
 
+// What the loop did, into the stage's result (and on stderr): its runs
+// against their predictions, the outcome, the correction, and the map's
+// candidates corrected as predicted candidates.
+static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const cal_mf_result *m,
+                      const char *tier, const cal_bounds *b)
+{
+    out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
+    out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
+    for (int k = 0; k < n_measurements(out); ++k) out->correction[k] = m->delta[k];
+    for (int i = 0; i < m->n; ++i)
+        fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
+                tier, m->run[i].y[0], m->predicted[i][0]);
+    fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction at the last run: angle %+.2f°\n", out->two_tier_outcome,
+            m->n, tier, m->delta[0]);
+    if (!m->failed && m->n > 0) add_predicted(out, cheap, b, &m->correction);
+}
+
 int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, cal_friction_result *cheap, char *err, size_t len)
@@ -154,15 +171,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     cal_mf_result *m = calloc(1, sizeof *m);
     if (!m) return cal_friction_finish(tt.search), exp_fail(err, len, "out of memory");
     cal_mf_search(&map, &p, m);
-    out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
-    out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
-    for (int k = 0; k < n_y; ++k) out->correction[k] = m->delta[k];
-    for (int i = 0; i < m->n; ++i) // what each run measured against what the corrected map said before it
-        fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
-                t->name, m->run[i].y[0], m->predicted[i][0]);
-    fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction at the last run: angle %+.2f°\n", out->two_tier_outcome,
-            m->n, t->name, m->delta[0]);
-    if (!m->failed && m->n > 0) add_predicted(out, cheap, tt.bounds, &m->correction);
+    keep_loop(out, cheap, m, t->name, tt.bounds);
     free(m);
     return cal_friction_finish(tt.search);
 }
