@@ -404,7 +404,9 @@ static int check_predicted_cost(run *r)
         if (!t) continue; // stage 1's cylinders: small beside the drum runs
         cal_drum_case d = cal_drum_case_granule(r->c, t, r->c->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
         exp_drum_cost c = exp_drum_predict_cost(&d.def, t->max_time);
-        int speeds = t->rpm_count > 0 ? (int)t->rpm_count : 5; // a bed settles once for its speeds
+        double rpm[CAL_MAX_RPM]; // a bed settles once for the speeds it is turned at
+        int speeds = cal_friction_speeds(r->c, t, &r->angles, &r->areas, NULL, rpm, NULL, r->err, sizeof r->err);
+        if (speeds < 1) return 1;
         core_s += (s->planned * c.turn_particle_steps + (double)s->planned / speeds * c.fill_particle_steps) / predicted_rate;
         memory_mb = fmax(memory_mb, c.memory_mb), runs += s->planned;
     }
@@ -482,7 +484,7 @@ int cal_cmd_calibrate(int argc, char **argv)
     status = prepare(r);
     if (!status) {
         snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
-        r->env.workers = r->opt.jobs, r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2);
+        r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2); // workers: set by prepare, for the plan
         r->env.checkpoint_every_s = r->opt.checkpoint_every_s;
         status = calibrate(r, command);
     }

@@ -435,17 +435,27 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     return 0;
 }
 
+int cal_friction_speeds(const cal_config *c, const cal_tier *t, const cal_series *angles, const cal_series *areas,
+                        const cal_material *material, double rpm[CAL_MAX_RPM], double *angle_rpm, char *err, size_t len)
+{
+    cal_friction_result *r = calloc(1, sizeof *r);
+    if (!r) return exp_fail(err, len, "out of memory"), -1;
+    snprintf(r->surface, sizeof r->surface, "%s", material ? material->surface : c->granule_surface);
+    search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = len};
+    int n = set_targets(&s, angles, areas) ? -1 : s.n_sim;
+    for (int k = 0; k < n; ++k) rpm[k] = s.sim_rpm[k];
+    if (n >= 0 && angle_rpm) *angle_rpm = r->angle_rpm;
+    free(r);
+    return n;
+}
+
 int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
                               const cal_series *areas, const cal_material *material)
 {
-    cal_friction_result *r = calloc(1, sizeof *r);
+    double rpm[CAL_MAX_RPM];
     char err[512];
-    if (!r) return -1;
-    snprintf(r->surface, sizeof r->surface, "%s", material ? material->surface : c->granule_surface);
-    search s = {.c = c, .t = t, .material = material, .r = r, .err = err, .len = sizeof err};
-    int runs = set_targets(&s, angles, areas) ? -1 : s.n_sim * planned_candidates(t) * cal_tier_beds(t);
-    free(r);
-    return runs;
+    int speeds = cal_friction_speeds(c, t, angles, areas, material, rpm, NULL, err, sizeof err);
+    return speeds < 0 ? -1 : speeds * planned_candidates(t) * cal_tier_beds(t);
 }
 
 // The stage's search with its targets set: what a one-tier stage and the

@@ -150,6 +150,13 @@ const cal_bounds *cal_friction_bounds(const cal_friction_search *s);
 /// if a simulation could not be stored or every candidate failed.
 int cal_friction_finish(cal_friction_search *s);
 
+/// The speeds stage 2 (material == NULL) or 3 simulates at tier t, as its
+/// search does: the data's CSA speeds for the stage's surface (those of the
+/// tier's rpm list, if it has one), then the angle's speed if not among them
+/// (in *angle_rpm, unless NULL). How many, or -1 with a message.
+int cal_friction_speeds(const cal_config *c, const cal_tier *t, const cal_series *angles, const cal_series *areas,
+                        const cal_material *material, double rpm[CAL_MAX_RPM], double *angle_rpm, char *err, size_t len);
+
 /// Stage 2 (material == NULL) or 3 (a material of the config), one tier.
 int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,

@@ -19,6 +19,7 @@
 #include "cal_data.h"
 #include "cal_mpi.h"
 #include "cal_sim.h"
+#include "cal_stages.h"
 #include "cal_util.h"
 #include "exp_common.h"
 
@@ -26,7 +27,7 @@
 #include <omp.h>
 #endif
 
-enum { MAX_SEEDS = 16, MAX_WALLS = 16, MAX_SPEEDS = 32 };
+enum { MAX_SEEDS = 16, MAX_WALLS = 16 };
 
 static const char help[] =
     "usage: granucal synthesize [CONFIG.yaml] [options]\n"
@@ -158,39 +159,26 @@ typedef struct job {
     const cal_tier *t;
     cal_env env;
     double k_n, gg_mu_s, gg_mu_r;
-    double rpm[MAX_SPEEDS], angle_rpm;
+    double rpm[CAL_MAX_RPM], angle_rpm;
     int n_rpm;
     lining linings[MAX_WALLS + 1];
     int n_linings;
     char out[1024], err[2048];
 } job;
 
-// The speeds: the tier's, else every speed of the config's occupied-area
-// file for the granule lining (as a calibration takes them), and the angle's
-// speed from the config's angle file.
+// The speeds the calibration's granule stage simulates at this tier, from the
+// config's data files (cal_friction_speeds): the same runs a candidate makes.
 static int choose_speeds(job *j)
 {
     char path[1200];
     cal_series angles, areas;
     cal_config_data_path(j->c, j->c->repose_angle, path, sizeof path);
     if (cal_series_load(&angles, path, CAL_DATA_ANGLE, j->err, sizeof j->err)) return 1;
-    const cal_point *p[64];
-    size_t n = cal_series_select(&angles, j->c->granule_surface, p, 64);
-    if (n > 0) j->angle_rpm = p[0]->rpm;
-    cal_series_free(&angles);
-    if (n == 0) return exp_fail(j->err, sizeof j->err, "%s: no angle for surface '%s'", path, j->c->granule_surface);
-    for (unsigned k = 0; k < j->t->rpm_count && j->n_rpm < MAX_SPEEDS; ++k) j->rpm[j->n_rpm++] = j->t->rpm[k];
-    if (j->n_rpm == 0) {
-        cal_config_data_path(j->c, j->c->occupied_area, path, sizeof path);
-        if (cal_series_load(&areas, path, CAL_DATA_CSA, j->err, sizeof j->err)) return 1;
-        n = cal_series_select(&areas, j->c->granule_surface, p, 64);
-        for (size_t k = 0; k < n && j->n_rpm < MAX_SPEEDS; ++k) j->rpm[j->n_rpm++] = p[k]->rpm;
-        cal_series_free(&areas);
-    }
-    int has_angle = 0;
-    for (int k = 0; k < j->n_rpm; ++k) has_angle |= j->rpm[k] == j->angle_rpm;
-    if (!has_angle && j->n_rpm < MAX_SPEEDS) j->rpm[j->n_rpm++] = j->angle_rpm;
-    return 0;
+    cal_config_data_path(j->c, j->c->occupied_area, path, sizeof path);
+    if (cal_series_load(&areas, path, CAL_DATA_CSA, j->err, sizeof j->err)) return cal_series_free(&angles), 1;
+    j->n_rpm = cal_friction_speeds(j->c, j->t, &angles, &areas, NULL, j->rpm, &j->angle_rpm, j->err, sizeof j->err);
+    cal_series_free(&angles), cal_series_free(&areas);
+    return j->n_rpm < 0;
 }
 
 // The granule lining, then each config material with its --wall pair.
@@ -244,7 +232,7 @@ static summary summarise(const double *v, int n)
 
 /// Per lining and speed: the angle and CSA over the seeds.
 typedef struct lining_result {
-    summary angle[MAX_SPEEDS], csa[MAX_SPEEDS];
+    summary angle[CAL_MAX_RPM], csa[CAL_MAX_RPM];
 } lining_result;
 
 // Run (or read from the store) one lining's seeds; a speed with no usable
