@@ -16,10 +16,6 @@
 #include "exp_scene.h"
 #include "exp_yaml.h"
 
-// Fixed spheres: this density makes a contact force move one by less than
-// 1e-12 m over the run; gravity is cancelled by the velocity reset.
-#define FIXED_DENSITY 1e12
-
 exp_silo_def exp_default_silo_def(void)
 {
     exp_silo_def d;
@@ -95,6 +91,20 @@ static dem_world *create_vessel(const exp_silo_def *d, const dem_contact_params 
     return w;
 }
 
+// One sphere of the plate, fixed (dem_world_set_granule_fixed) at `p`: the
+// engine holds it still against gravity and its contacts, as LIGGGHTS holds
+// the same spheres in tests/peers/silo/in.silo by integrating only the
+// flowing group. Its density is the granules' (written so in silo_initial.data);
+// it enters the reduced mass of the fill's dashpot as any granule's does.
+// The world is not re-sorted while the plate is built, so the granule just
+// added is the last of the view.
+static int add_plate_sphere(dem_world *w, const exp_silo_def *d, dem_vec3 p)
+{
+    if (dem_world_add_granule(w, p, dem_v3(0, 0, 0), dem_v3(0, 0, 0), d->plate_sphere_radius, d->density) < 0)
+        return -1;
+    return dem_world_set_granule_fixed(w, dem_world_granules(w).count - 1, 1) == DEM_OK ? 0 : -1;
+}
+
 // Rings of fixed spheres from the silo wall inwards down to radius `inner`
 // (centres), 2.02 a apart radially and at least 2a along each ring, each ring
 // turned by half a spacing against the previous one; a centre sphere if
@@ -109,15 +119,12 @@ static long add_rings(dem_world *w, const exp_silo_def *d, double outer, double 
         if (m < 3) break;
         for (int j = 0; j < m; ++j) {
             double phi = 2 * DEM_PI * (j + 0.5 * (k % 2)) / m;
-            if (dem_world_add_granule(w, dem_v3(rho * cos(phi), rho * sin(phi), d->plate_z), dem_v3(0, 0, 0),
-                                      dem_v3(0, 0, 0), a, FIXED_DENSITY) < 0)
-                return -1;
+            if (add_plate_sphere(w, d, dem_v3(rho * cos(phi), rho * sin(phi), d->plate_z))) return -1;
             n++;
         }
     }
     if (centre) {
-        if (dem_world_add_granule(w, dem_v3(0, 0, d->plate_z), dem_v3(0, 0, 0), dem_v3(0, 0, 0), a, FIXED_DENSITY) < 0)
-            return -1;
+        if (add_plate_sphere(w, d, dem_v3(0, 0, d->plate_z))) return -1;
         n++;
     }
     return n;
@@ -130,27 +137,6 @@ static double plate_inner_ring(const exp_silo_def *d)
     double a = d->plate_sphere_radius, outer = d->silo_radius - a, rho = outer;
     while (rho - 2.02 * a - a >= d->orifice_radius - 1e-9) rho -= 2.02 * a;
     return rho;
-}
-
-// Hold the fixed spheres (ids below n_fixed) still: velocity Verlet's first
-// half kick adds g·Δt/2, so a velocity of −g·Δt/2 makes the drift zero (their
-// own contact forces over a mass of FIXED_DENSITY·V are negligible).
-static void hold_fixed(dem_world *w, size_t n_fixed)
-{
-    dem_granules_view g = dem_world_granules(w);
-    dem_vec3 v = dem_v3(0, 0, 0.5 * 9.81 * dem_world_dt(w));
-    for (size_t i = 0; i < g.count; ++i)
-        if (g.id[i] < n_fixed) dem_world_set_granule_velocity(w, i, v, dem_v3(0, 0, 0));
-}
-
-static dem_status step_held(dem_world *w, size_t n_fixed, uint64_t steps)
-{
-    for (uint64_t s = 0; s < steps; ++s) {
-        hold_fixed(w, n_fixed);
-        dem_status st = dem_world_step(w, 1);
-        if (st != DEM_OK) return st;
-    }
-    return DEM_OK;
 }
 
 // Kinetic energy of the flowing granules (ids from n_fixed on).
@@ -204,7 +190,7 @@ static dem_world *fill(const exp_silo_def *d, exp_progress_fn progress, void *ct
     // their weight times d50 (or fill_max_time).
     double weight = (double)d->n_granules * d->density * DEM_PI / 6 * pow(d->gsd.median_diameter, 3) * 9.81;
     for (double t = 0; t < d->fill_max_time; t += 0.5) {
-        if (step_held(w, (size_t)plate, (uint64_t)(0.5 / d->dt + 0.5)) != DEM_OK) {
+        if (dem_world_step(w, (uint64_t)(0.5 / d->dt + 0.5)) != DEM_OK) {
             exp_fail(err, len, "silo fill: %s", dem_world_error(w));
             dem_world_destroy(w);
             return NULL;
@@ -281,7 +267,7 @@ dem_status exp_silo_discharge(dem_world *w, const exp_silo_def *d, size_t plate_
                 s->discharged++, s->discharged_mass += g.mass[i];
         if (done >= total || out->n_series >= cap) break;
         uint64_t n = total - done < per ? total - done : per;
-        st = step_held(w, plate_spheres, n);
+        st = dem_world_step(w, n);
         done += n;
         if (st != DEM_OK) break;
         if (progress) progress("discharge", s->t, out->granules, ctx);
@@ -309,7 +295,7 @@ int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp
     for (size_t i = 0; i < g.count; ++i) {
         int plate = g.id[i] < plate_spheres;
         fprintf(f, "%llu %d %.17g %.17g %.17g %.17g %.17g\n", (unsigned long long)g.id[i] + 1, plate ? 2 : 1,
-                2 * g.radius[i], plate ? d->density : d->density, g.position[i].x, g.position[i].y, g.position[i].z);
+                2 * g.radius[i], d->density, g.position[i].x, g.position[i].y, g.position[i].z);
     }
     if (fclose(f) != 0 || rename(tmp, path) != 0) return exp_fail(err, len, "cannot write '%s'", path);
     return 0;

@@ -17,8 +17,9 @@
 ///    discs and infinite cylinders, and a disc pushes every granule in its
 ///    footprint below it, so a plate with a hole cannot be a wall; fixed
 ///    spheres are what LIGGGHTS gets too (a frozen atom group), so both codes
-///    see the same bumpy plate. Fixed spheres are granules of huge density
-///    whose velocity is reset every step (see exp_silo.c).
+///    see the same bumpy plate. Fixed spheres are the engine's fixed granules
+///    (dem_world_set_granule_fixed), at the granules' density: LIGGGHTS
+///    integrates only the `flow` group, which holds its plate still alike.
 ///  - fill: granules on a lattice above the plate, the orifice closed by a
 ///    gate of more fixed spheres, settled with a temporary dashpot (ξ_fill)
 ///    until at rest; then the discharge starts from that state in a fresh
