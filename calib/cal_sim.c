@@ -30,17 +30,16 @@ static dem_damping_mode config_damping(const cal_config *c)
 static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
                                double wall_mu_s, double wall_mu_r)
 {
+    // A tier with a slice depth runs a periodic slice of the config's drum.
+    exp_drum_physics p = {.diameter = c->diameter, .periodic = t->slice_depth > 0, .depth = c->depth,
+                          .slice_depth = t->slice_depth, .fill = c->fill, .lambda = t->lambda,
+                          .gsd = {c->median_diameter, c->geometric_sd, c->truncation_sigmas},
+                          .density = c->density, .k_n = k_n, .xi = c->xi, .damping = config_damping(c),
+                          .mu_s = gg_mu_s, .mu_r = gg_mu_r, .wall_mu_s = wall_mu_s, .wall_mu_r = wall_mu_r,
+                          .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)c->seed};
+    if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &p.fill_method); // checked on loading
     cal_drum_case d;
-    d.def = exp_default_drum_def();
-    d.def.diameter = c->diameter, d.def.fill = c->fill;
-    d.def.periodic = t->slice_depth > 0;
-    d.def.depth = d.def.periodic ? t->slice_depth : c->depth;
-    d.def.lambda = t->lambda, d.def.density = c->density, d.def.seed = (uint64_t)c->seed;
-    d.def.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
-    d.def.granule = exp_granule_pair(k_n, c->xi, gg_mu_s, gg_mu_r, config_damping(c));
-    d.def.wall = exp_boundary_pair(&d.def.granule, wall_mu_s, wall_mu_r);
-    d.def.end_plate = d.def.wall;
-    if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &d.def.fill_method); // checked on loading
+    d.def = exp_drum_def_from_physics(&p);
     d.run = exp_default_drum_run_opts();
     d.run.average_time = t->average_time;
     d.run.max_time = t->max_time, d.run.window = t->window;

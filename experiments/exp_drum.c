@@ -56,6 +56,20 @@ exp_drum_def exp_default_drum_def(void)
     return d;
 }
 
+exp_drum_def exp_drum_def_from_physics(const exp_drum_physics *p)
+{
+    exp_drum_def d = exp_default_drum_def();
+    d.diameter = p->diameter, d.fill = p->fill, d.periodic = p->periodic;
+    d.depth = p->periodic ? p->slice_depth : p->depth;
+    d.lambda = p->lambda, d.density = p->density, d.seed = p->seed;
+    d.gsd = p->gsd;
+    d.granule = exp_granule_pair(p->k_n, p->xi, p->mu_s, p->mu_r, p->damping);
+    d.wall = exp_boundary_pair(&d.granule, p->wall_mu_s, p->wall_mu_r);
+    d.end_plate = d.wall;
+    d.fill_method = p->fill_method;
+    return d;
+}
+
 int exp_drum_check(const exp_drum_def *d, char *msg, size_t len)
 {
     char sub[256];

@@ -48,9 +48,35 @@ typedef struct exp_drum_def {
     exp_drum_fill_method fill_method; ///< how the bed is built (EXP_FILL_POUR)
 } exp_drum_def;
 
-/// Defaults: the paper's drum and powder, Table 3, λ = 64, a periodic
-/// slice of 10 mm... see exp_drum.c.
+/// Defaults: the paper's drum (100 mm across, 44 mm deep, the whole drum with
+/// its end plates, 43 % full) and powder, Table 3's contacts, λ = 64.
 exp_drum_def exp_default_drum_def(void);
+
+/// What a drum run is physically, as both configs that describe one give it:
+/// the drum YAML (exp_drum_config.c) and the calibration config with a tier
+/// and a candidate's parameters (calib/cal_sim.c). exp_drum_def_from_physics
+/// is the one rule that turns it into an exp_drum_def.
+typedef struct exp_drum_physics {
+    double diameter;    ///< m
+    int periodic;       ///< 1: a periodic slice `slice_depth` deep; 0: the whole drum, `depth` deep
+    double depth;       ///< the whole drum's depth, m
+    double slice_depth; ///< the periodic slice's depth, m
+    double fill;        ///< fill degree
+    double lambda;      ///< coarse-graining scale factor
+    dem_gsd gsd;        ///< real granule size distribution
+    double density;     ///< real granule density, kg/m³
+    double k_n, xi;     ///< granule–granule normal stiffness (real, N/m) and damping ratio
+    dem_damping_mode damping;
+    double mu_s, mu_r;           ///< granule–granule friction
+    double wall_mu_s, wall_mu_r; ///< granule–drum friction: the wall and the end plates
+    exp_drum_fill_method fill_method;
+    uint64_t seed;
+} exp_drum_physics;
+
+/// The drum definition of `p`: Table 3's contact pairs (exp_granule_pair; the
+/// wall and the end plates exp_boundary_pair of it at the drum's friction),
+/// the depth of the slice or of the drum; the rest (pixel, closing) default.
+exp_drum_def exp_drum_def_from_physics(const exp_drum_physics *p);
 
 /// Check a definition; a message names the field.
 int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);

@@ -117,25 +117,23 @@ static int located(const char *path, const char *field, char *err, size_t len, c
 
 int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run_opts *run, char *err, size_t len)
 {
-    *def = exp_default_drum_def();
     *run = exp_default_drum_run_opts();
-    def->diameter = y->diameter, def->fill = y->fill, def->periodic = y->periodic;
-    def->depth = y->periodic ? y->slice_depth : y->depth;
-    def->lambda = y->lambda, def->density = y->density, def->seed = (uint64_t)y->seed;
-    def->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
-    dem_damping_mode mode;
-    if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
-    def->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, y->mu_r, mode);
+    exp_drum_physics p = {.diameter = y->diameter, .periodic = y->periodic, .depth = y->depth,
+                          .slice_depth = y->slice_depth, .fill = y->fill, .lambda = y->lambda,
+                          .gsd = {y->median_diameter, y->geometric_sd, y->truncation_sigmas},
+                          .density = y->density, .k_n = y->k_n, .xi = y->xi, .mu_s = y->mu_s, .mu_r = y->mu_r,
+                          .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)y->seed};
+    if (exp_damping_from_name(y->damping, "damping", &p.damping, err, len)) return 1;
     // "granules": a lining of granules is a granular surface (assumption iii)
-    def->wall = exp_boundary_pair(&def->granule, y->mu_s, y->mu_r);
+    p.wall_mu_s = y->mu_s, p.wall_mu_r = y->mu_r;
     if (strcmp(y->wall, "granules") != 0) {
         const exp_material_yaml *m = find_material(y, y->wall);
         if (!m) return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
-        def->wall = exp_boundary_pair(&def->granule, m->mu_s, m->mu_r);
+        p.wall_mu_s = m->mu_s, p.wall_mu_r = m->mu_r;
     }
-    def->end_plate = def->wall;
-    if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &def->fill_method))
+    if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &p.fill_method))
         return exp_fail(err, len, "fill_method = '%s': use pour or pack", y->fill_method);
+    *def = exp_drum_def_from_physics(&p);
     if (y->pixel > 0) def->pixel = y->pixel;
     if (y->closing_px > 0) def->closing_px = y->closing_px;
     run->rpm = y->rpm, run->max_time = y->max_time;
