@@ -102,7 +102,7 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
     run.rpm = y->rpm = rpm;
     // The run's checkpoint, labelled with what defines it (as a calibration's record).
     char key[2048], ck_path[1200];
-    cal_drum_case whole = {*def, *def, run};
+    cal_drum_case whole = {.def = *def, .fill = *def, .run = run};
     cal_drum_key(&whole, rpm, key, sizeof key);
     snprintf(ck_path, sizeof ck_path, "%s/checkpoint.h5", sub);
     exp_drum_checkpoint ck = {ck_path, key, checkpoint_every_s};
