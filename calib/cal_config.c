@@ -38,6 +38,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     TIER_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, fill_method, 1, 16),
     TIER_FLOAT("average_time", average_time, CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_SEQUENCE("average_time_per_rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, average_time_per_rpm,
+                         &float_entry, 1, 32),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
     TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
     CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
@@ -204,6 +206,26 @@ static int check_map_tier(const cal_config *c, const cal_tier *t, int from, char
     return 0;
 }
 
+// One averaging time per speed, each fitting the run like average_time, and
+// not both keys: which one would hold is not for the reader to guess.
+static int check_average_per_rpm(const cal_config *c, const cal_tier *t, int from, char *err, size_t len)
+{
+    if (t->average_time_per_rpm_count == 0) return 0;
+    if (t->average_time > 0)
+        return located(c, from, "average_time_per_rpm", err, len, "give average_time or average_time_per_rpm, not both");
+    if (t->average_time_per_rpm_count != t->rpm_count)
+        return located(c, from, "average_time_per_rpm", err, len, "%u values for %u speeds: give one per entry of rpm",
+                       t->average_time_per_rpm_count, t->rpm_count);
+    for (unsigned k = 0; k < t->average_time_per_rpm_count; ++k) {
+        double a = t->average_time_per_rpm[k];
+        if (!(isfinite(a) && a >= 0 && 2 * t->window + a <= t->max_time))
+            return located(c, from, "average_time_per_rpm", err, len,
+                           "%g must be >= 0 and fit with two windows (%g s) in max_time (%g s)", a, 2 * t->window,
+                           t->max_time);
+    }
+    return 0;
+}
+
 static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
@@ -235,6 +257,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         if (!(t->csa_sd_percent[k] >= 0 && t->csa_sd_percent[k] < 50))
             return located(c, from, "csa_sd_percent", err, len, "%g must be in [0, 50) percentage points",
                            t->csa_sd_percent[k]);
+    if (check_average_per_rpm(c, t, from, err, len)) return 1;
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
 }
 
@@ -245,6 +268,13 @@ double cal_tier_csa_sd(const cal_tier *t, unsigned i)
 {
     if (t->csa_sd_percent_count == 0) return 0;
     return t->csa_sd_percent[t->csa_sd_percent_count == 1 ? 0 : i];
+}
+
+double cal_tier_average_time(const cal_tier *t, double rpm)
+{
+    for (unsigned k = 0; k < t->average_time_per_rpm_count && k < t->rpm_count; ++k)
+        if (t->rpm[k] == rpm) return t->average_time_per_rpm[k];
+    return t->average_time;
 }
 
 static int check_fidelity(const cal_config *c, char *err, size_t len)

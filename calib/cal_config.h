@@ -33,6 +33,11 @@ typedef struct cal_tier {
     double steady_angle_tol_deg, steady_csa_tol_percent;
     char *fill_method;      ///< how the drum's bed is built: "pour" (absent) or "pack" (exp_drum_fill_method)
     double average_time;    ///< s averaged on after the steady test holds (exp_drum_run_opts; 0: none)
+    /// The same, one per entry of rpm (replaces average_time): a slow drum
+    /// avalanches and needs seconds of averaging for its angle, a fast one
+    /// flows steadily and needs far less for its CSA.
+    double *average_time_per_rpm;
+    unsigned average_time_per_rpm_count;
     double *rpm;            ///< speeds simulated; empty = every speed in the data
     unsigned rpm_count;
     double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
@@ -77,6 +82,9 @@ int cal_tier_beds(const cal_tier *t);
 int cal_tier_bound_probes(const cal_tier *t);
 /// The tier's CSA spread at speed index i of its rpm list (0: not measured).
 double cal_tier_csa_sd(const cal_tier *t, unsigned i);
+/// Seconds a run at `rpm` averages after its steady test: average_time_per_rpm's
+/// entry for that speed, else average_time.
+double cal_tier_average_time(const cal_tier *t, double rpm);
 
 /// A rung of the fidelity study: the drum's accuracy knobs only.
 typedef struct cal_rung {

@@ -42,6 +42,9 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     d.def = exp_drum_def_from_physics(&p);
     d.run = exp_default_drum_run_opts();
     d.run.average_time = t->average_time;
+    d.n_average = 0;
+    for (unsigned k = 0; k < t->average_time_per_rpm_count && k < t->rpm_count && k < CAL_CASE_MAX_RPM; ++k)
+        d.average_rpm[d.n_average] = t->rpm[k], d.average_time[d.n_average++] = t->average_time_per_rpm[k];
     d.run.max_time = t->max_time, d.run.window = t->window;
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
     if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
@@ -98,9 +101,18 @@ static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
         snprintf(out + strlen(out), len - strlen(out), " fill_method=%s", exp_drum_fill_method_name(d->fill_method));
 }
 
+exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm)
+{
+    exp_drum_run_opts run = c->run;
+    run.rpm = rpm;
+    for (int k = 0; k < c->n_average; ++k)
+        if (c->average_rpm[k] == rpm) run.average_time = c->average_time[k];
+    return run;
+}
+
 void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
 {
-    const exp_drum_run_opts *r = &c->run;
+    const exp_drum_run_opts run = cal_drum_run_opts(c, rpm), *r = &run;
     char def[1024], turn_wall[160], fill_wall[160], turn_plate[160], fill_plate[160];
     drum_def_text(&c->def, def, sizeof def);
     // Only the fill's wall pair may differ from the turn's (cal_drum_case_wall).
@@ -229,8 +241,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
 {
     const cal_drum_case *c = &b->cases[r.c];
     const char *key = run_key(b, r);
-    exp_drum_run_opts run = c->run;
-    run.rpm = b->rpm[r.k];
+    exp_drum_run_opts run = cal_drum_run_opts(c, b->rpm[r.k]);
     dem_world *w = own ? bed : dem_world_clone(bed);
     if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
     char ck_path[1300];

@@ -50,11 +50,21 @@ int cal_parse_checkpoint_every(const char *command, const char *text, double *ou
 
 /// A drum candidate: the drum and powder, how its bed is settled, and how
 /// each speed is run.
+enum { CAL_CASE_MAX_RPM = 32 };
+
 typedef struct cal_drum_case {
     exp_drum_def def;  ///< turned with these pairs
     exp_drum_def fill; ///< settled with these (the same drum; only the wall pair may differ)
     exp_drum_run_opts run;
+    /// Speeds averaged for another time than run.average_time (a tier's
+    /// average_time_per_rpm); read through cal_drum_run_opts.
+    int n_average;
+    double average_rpm[CAL_CASE_MAX_RPM], average_time[CAL_CASE_MAX_RPM];
 } cal_drum_case;
+
+/// The run options of case c turned at `rpm`: its speed, and its averaging
+/// time at that speed.
+exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm);
 
 /// Stage 2: the drum lined with granules (wall pair = granule pair) at
 /// granule stiffness k_n, settled and turned with that pair. The bed's

@@ -17,6 +17,7 @@
 
 #include "cal_config.h"
 #include "cal_data.h"
+#include "cal_sim.h"
 #include "cal_stages.h"
 #include "cal_store.h"
 #include "cal_util.h"
@@ -235,6 +236,38 @@ static void test_bad_config_named_by_line_and_field(void **state)
     expect_config_error("map_tier: ci", "map_tier: standard", "map_tier");  // itself
     expect_config_error("map_tier: ci", "map_tier: quick", "map_tier");     // other speeds
     expect_config_error("beds: 2", "beds: 40", "beds");
+    // average_time_per_rpm (the ci tier: rpm [4, 40, 116], max_time 4, window 1; standard: average_time)
+    expect_config_error("beds: 2", "beds: 2\n    average_time_per_rpm: [1.0, 1.0]", "average_time_per_rpm");
+    expect_config_error("beds: 2", "beds: 2\n    average_time_per_rpm: [1.0, 1.0, 2.5]", "average_time_per_rpm");
+    expect_config_error("beds: 2", "beds: 2\n    average_time_per_rpm: [1.0, -1.0, 1.0]", "average_time_per_rpm");
+    expect_config_error("beds: 2", "beds: 2\n    average_time: 1.0\n    average_time_per_rpm: [1.0, 1.0, 1.0]",
+                        "average_time_per_rpm"); // both keys
+}
+
+// A tier's averaging time per speed reaches each run's options and its store key.
+static void test_average_time_per_rpm(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/granucal_avg_XXXXXX", err[1024], key4[2048], key40[2048], key116[2048];
+    static char edited[1 << 16];
+    edit_shipped("calibration.yaml", "beds: 2", "beds: 2\n    average_time_per_rpm: [2.0, 0.5, 0]", edited, sizeof edited);
+    close(mkstemp(path));
+    write_file(path, edited);
+    cal_config *c = cal_config_load(path, "ci", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    const cal_tier *t = cal_config_tier(c);
+    assert_true(cal_tier_average_time(t, 4) == 2.0 && cal_tier_average_time(t, 40) == 0.5);
+    assert_true(cal_tier_average_time(t, 116) == 0 && cal_tier_average_time(t, 80) == 0); // 80: not a tier speed
+    cal_drum_case d = cal_drum_case_granule(c, t, 200, 0.8, 0.2);
+    assert_true(cal_drum_run_opts(&d, 4).average_time == 2.0 && cal_drum_run_opts(&d, 4).rpm == 4);
+    assert_true(cal_drum_run_opts(&d, 40).average_time == 0.5 && cal_drum_run_opts(&d, 116).average_time == 0);
+    cal_drum_key(&d, 4, key4, sizeof key4), cal_drum_key(&d, 40, key40, sizeof key40);
+    cal_drum_key(&d, 116, key116, sizeof key116);
+    assert_non_null(strstr(key4, " average_time=2"));
+    assert_non_null(strstr(key40, " average_time=0.5"));
+    assert_null(strstr(key116, "average_time")); // 0: named only when set, as before the key existed
+    cal_config_free(c);
+    unlink(path);
 }
 
 // What fuzzing the loaders found (tests/fuzz): each was accepted, or crashed.
@@ -512,6 +545,7 @@ int main(void)
         cmocka_unit_test(test_shipped_config_loads),
         cmocka_unit_test(test_bound_probes_read),
         cmocka_unit_test(test_bad_config_named_by_line_and_field),
+        cmocka_unit_test(test_average_time_per_rpm),
         cmocka_unit_test(test_fuzz_findings_refused),
         cmocka_unit_test(test_store_round_trip_and_collision_check),
         cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
