@@ -86,7 +86,7 @@ static void zero_pointers(dem_world *s)
     memset(&s->nl_old, 0, sizeof s->nl_old);
     s->imp = NULL;
     s->nl.start = NULL, s->nl.j = s->nl.row = NULL, s->nl.constants = NULL, s->nl.hist = NULL;
-    for (int k = 0; k < DEM_MAX_WALLS; ++k) s->walls[k].hist = NULL, s->walls[k].near = NULL, s->walls[k].def.name = NULL;
+    for (int k = 0; k < DEM_MAX_WALLS; ++k) s->walls[k].hist = NULL, s->walls[k].near = NULL, s->walls[k].force = NULL, s->walls[k].def.name = NULL;
 }
 
 static void put_world(ck_file *c, const dem_world *w)
@@ -119,6 +119,8 @@ static void put_world(ck_file *c, const dem_world *w)
         put_doubles(c, name, n * (size_t)w->walls[k].hist_len, w->walls[k].hist);
         snprintf(name, sizeof name, "wall%d_near", k);
         put(c, name, H5T_NATIVE_UINT32, w->walls[k].near_count, w->walls[k].near);
+        snprintf(name, sizeof name, "wall%d_force", k);
+        put_doubles(c, name, 3 * w->walls[k].near_count, w->walls[k].force);
     }
 }
 
@@ -255,6 +257,8 @@ static void get_arrays(ck_file *c, dem_world *w)
         get(c, name, D, n * (size_t)wall->hist_len, wall->hist);
         snprintf(name, sizeof name, "wall%d_near", k);
         wall->near = get_new(c, name, H5T_NATIVE_UINT32, wall->near_count, cap, sizeof(uint32_t));
+        snprintf(name, sizeof name, "wall%d_force", k);
+        wall->force = get_new(c, name, D, wall->near_count, cap, sizeof(dem_vec3));
         wall->near_cap = cap;
     }
 }

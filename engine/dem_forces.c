@@ -28,6 +28,8 @@ void dem_forces_crossing(dem_world *w, const uint32_t *rows, size_t count, size_
     dem_pairs_crossing(w, rows, count, end);
 }
 
+void dem_forces_blocks_begin(dem_world *w) { dem_wall_contacts_begin(w); }
+
 void dem_forces_block(dem_world *w, size_t lo, size_t hi)
 {
     dem_pairs_block(w, lo, hi);

@@ -18,11 +18,13 @@ int dem_forces_threaded(const dem_world *w);
 // any threads, dem_forces_crossing for such rows of a block ending at `end`
 // (each row on one thread), computing those pairs into their slots; then a
 // barrier, and on each thread dem_forces_block (the block's other pairs and
-// its walls). Bitwise the same forces as dem_forces_compute.
+// its walls). Bitwise the same forces as dem_forces_compute. Before the
+// first such evaluation, on one thread, dem_forces_blocks_begin.
 int dem_forces_blockwise(const dem_world *w);
 size_t dem_forces_crossing_rows(const dem_world *w, size_t lo, size_t hi, uint32_t *rows);
 void dem_forces_crossing(dem_world *w, const uint32_t *rows, size_t count, size_t end);
 void dem_forces_block(dem_world *w, size_t lo, size_t hi);
+void dem_forces_blocks_begin(dem_world *w);
 // The lowest and highest centre of granules [lo, hi) along the periodic
 // axis (+inf and −inf for none, or without the axis), and whether centres
 // spanning [lowest, highest] there are near enough for one wrap to give

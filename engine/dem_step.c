@@ -455,6 +455,7 @@ static team_result step_team(dem_world *w, uint64_t steps)
     uint32_t *rows = malloc(w->n * sizeof *rows);
     if (slot && rows) {
         w->hist_dt = w->dt;
+        dem_forces_blocks_begin(w);
 #pragma omp parallel num_threads(team)
         {
             const team_result mine = team_thread(w, slot, rows, steps);

@@ -13,11 +13,17 @@ int dem_wall_near_rebuild(dem_wall *wall, size_t n, const dem_vec3 *pos, const d
 {
     dem_wall_def grown = wall->def;
     if (grown.kind == DEM_WALL_DISC) grown.radius += skin;
-    if (wall->near_cap < n) {
-        uint32_t *p = realloc(wall->near, (n ? n : 1) * sizeof *p);
+    // The last evaluation's total outlives its entries, which name the old list.
+    wall->force_carried = dem_v3_neg(dem_wall_force_total(wall));
+    if (wall->near_cap < n || !wall->force) {
+        const size_t cap = n > wall->near_cap ? n : wall->near_cap;
+        uint32_t *p = realloc(wall->near, (cap ? cap : 1) * sizeof *p);
         if (!p) return 1;
         wall->near = p;
-        wall->near_cap = n;
+        dem_vec3 *f = realloc(wall->force, (cap ? cap : 1) * sizeof *f);
+        if (!f) return 1;
+        wall->force = f;
+        wall->near_cap = cap;
     }
     const size_t hl = (size_t)wall->hist_len;
     size_t count = 0;
@@ -26,6 +32,14 @@ int dem_wall_near_rebuild(dem_wall *wall, size_t n, const dem_vec3 *pos, const d
         else if (hl) memset(wall->hist + i * hl, 0, hl * sizeof(double));
     }
     wall->near_count = count;
+    memset(wall->force, 0, count * sizeof *wall->force);
     wall->point_at_build = wall->def.point;
     return 0;
+}
+
+dem_vec3 dem_wall_force_total(const dem_wall *wall)
+{
+    dem_vec3 sum = wall->force_carried;
+    for (size_t k = 0; k < wall->near_count; ++k) sum = dem_v3_add(sum, wall->force[k]);
+    return dem_v3_neg(sum);
 }

@@ -27,7 +27,20 @@ typedef struct dem_wall {
     uint32_t *near;
     size_t near_count, near_cap;
     dem_vec3 point_at_build; // def.point when the near list was built: a caller may move the wall
+    // force[k]: the force this wall put on granule near[k] at the last force
+    // evaluation (0 where it did not touch), near_cap entries. Kept per entry,
+    // not summed as the threads go, so that the total (dem_wall_force_total)
+    // is added in one order, the same bits on any number of threads.
+    dem_vec3 *force;
+    // The total of force[] as it was when the near list was last rebuilt
+    // (force[] is then zeroed: its entries named the old list's granules);
+    // cleared by the next evaluation, which writes every entry.
+    dem_vec3 force_carried;
 } dem_wall;
+
+// The force the granules put on the wall at the last force evaluation:
+// minus the sum of what it put on them, in near-list order.
+dem_vec3 dem_wall_force_total(const dem_wall *wall);
 
 // How far the wall has moved since its near list was built, squared.
 static inline double dem_wall_travel2(const dem_wall *wall)

@@ -84,7 +84,7 @@ void dem_world_destroy(dem_world *w)
                       w->pair_n, w->pair_g, w->damp, w->acc, w->fixed,
                       w->pos_at_build};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) free(arrays[k]);
-    for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist), free(w->walls[k].near);
+    for (int k = 0; k < w->n_walls; ++k) free(w->walls[k].hist), free(w->walls[k].near), free(w->walls[k].force);
     dem_nl_free(&w->nl);
     dem_nl_free(&w->nl_old);
     dem_implicit_free(w->imp);
@@ -112,6 +112,7 @@ dem_world *dem_world_clone(const dem_world *w)
         size_t hl = (size_t)(w->walls[k].hist_len ? w->walls[k].hist_len : 1);
         c->walls[k].hist = dem_dup_bytes(w->walls[k].hist, (cap ? cap : 1) * hl * sizeof(double), &fail);
         c->walls[k].near = dem_dup_bytes(w->walls[k].near, w->walls[k].near_cap * sizeof *w->walls[k].near, &fail);
+        c->walls[k].force = dem_dup_bytes(w->walls[k].force, w->walls[k].near_cap * sizeof *w->walls[k].force, &fail);
     }
     dem_nl_clone(&c->nl, &w->nl, &fail);
     dem_nl_clone(&c->nl_old, &w->nl_old, &fail);
@@ -269,6 +270,12 @@ dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point)
 const dem_wall_def *dem_world_wall(const dem_world *w, int wall)
 {
     return wall >= 0 && wall < w->n_walls ? &w->walls[wall].def : NULL;
+}
+
+dem_vec3 dem_world_wall_force(const dem_world *w, int wall)
+{
+    if (wall < 0 || wall >= w->n_walls) return dem_v3(NAN, NAN, NAN);
+    return dem_wall_force_total(&w->walls[wall]);
 }
 
 dem_status dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p)

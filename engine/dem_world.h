@@ -158,6 +158,16 @@ dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point);
 /// A wall's definition as it now is (point and spin included); NULL for no
 /// such wall.
 const dem_wall_def *dem_world_wall(const dem_world *w, int wall);
+/// The total force the granules exert on a wall (N): minus the sum of the
+/// granule–wall contact forces of the last force evaluation, as the contact
+/// law computed them (normal spring, dashpot and tangential force; rolling
+/// resistance is a torque and is not in it). That evaluation is the one of
+/// the state after the last step, the forces each granule's second half kick
+/// used. Added in one order, the same bits on any number of threads. With
+/// implicit damping or implicit springs the velocity update also solves the
+/// dashpots and sticking springs implicitly; this is the explicit evaluation,
+/// not that correction. (0, 0, 0) before the first step; NaN for no such wall.
+dem_vec3 dem_world_wall_force(const dem_world *w, int wall);
 /// Change the granule–granule or a wall's contact parameters (calibration
 /// candidates); the feature mask is re-derived.
 dem_status dem_world_set_granule_contact(dem_world *w, const dem_contact_params *p);

@@ -129,8 +129,13 @@ static dem_status move_piston(dem_world *w, double y)
 }
 
 // Spring forces on the piston, the floor and the side wall: the normal
-// springs k_n·h of eq. 3 (the dashpot is left out: at the quasi-static rate
-// it is a small, rate-dependent part, see docs/experiments.md).
+// springs k_n·h of eq. 3. The dashpot is left out on purpose: at the
+// quasi-static rate it is a small, rate-dependent part (docs/experiments.md),
+// and σ = f_top / area (eq. 19's pressure, the reversal points and E') has
+// been this sum in every result published. The engine's own totals, dashpot
+// and friction included (dem_world_wall_force), are kept beside it
+// (wall_totals): they are not a sum of magnitudes, so the side wall's
+// normal load, which cancels as a vector around the die, is only here.
 static void wall_forces(const dem_world *w, const exp_compress_def *d, double piston_y, double *top, double *bottom,
                         double *side)
 {
@@ -147,6 +152,14 @@ static void wall_forces(const dem_world *w, const exp_compress_def *d, double pi
         if (hs > 0) fs += k * hs;
     }
     *top = ft, *bottom = fb, *side = fs;
+}
+
+// The engine's totals along the die's axis (see exp_compress_sample).
+static void wall_totals(const dem_world *w, exp_compress_sample *s)
+{
+    s->f_piston_axial = dem_world_wall_force(w, WALL_PISTON).y;
+    s->f_floor_axial = dem_world_wall_force(w, WALL_FLOOR).y;
+    s->f_side_axial = dem_world_wall_force(w, WALL_SIDE).y;
 }
 
 static double bed_top(const dem_world *w)
@@ -224,6 +237,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         sm.t = dem_world_time(w) - t0;
         sm.piston_y = y;
         wall_forces(w, d, y, &sm.f_top, &sm.f_bottom, &sm.f_side);
+        wall_totals(w, &sm);
         sm.sigma = sm.f_top / area;
         dem_diagnostics dg = dem_world_diagnose(w);
         sm.ke_over_elastic = dg.potential_elastic > 0 ? (dg.ke_translational + dg.ke_rotational) / dg.potential_elastic : 0;
@@ -341,12 +355,14 @@ int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path,
     snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
     FILE *f = fopen(tmp, "w");
     if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
+    // The engine's axial totals come last, so the columns before keep their places.
     fprintf(f, "t_s,cycle,loading,piston_y_m,displacement_m,strain,force_top_N,force_bottom_N,force_side_normal_N,"
-               "sigma_Pa,ke_over_elastic\n");
+               "sigma_Pa,ke_over_elastic,piston_axial_total_N,floor_axial_total_N,side_axial_total_N\n");
     for (size_t k = 0; k < r->n_curve; ++k) {
         const exp_compress_sample *s = &r->curve[k];
-        fprintf(f, "%.6g,%d,%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g\n", s->t, s->cycle, s->loading, s->piston_y,
-                s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic);
+        fprintf(f, "%.6g,%d,%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%.6g,%.6g,%.6g\n", s->t, s->cycle, s->loading,
+                s->piston_y, s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic,
+                s->f_piston_axial, s->f_floor_axial, s->f_side_axial);
     }
     if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
     if (!png_path) return 0;

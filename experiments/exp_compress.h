@@ -54,9 +54,15 @@ typedef struct exp_compress_sample {
     double piston_y;     ///< piston height above the die floor, m
     double displacement; ///< piston travel from where σ first reached σ_min, m (> 0 down)
     double strain;       ///< displacement / bed height at that point
-    double f_top;        ///< spring force of the granules on the piston, N
+    double f_top;        ///< spring force of the granules on the piston, N (Σ k h: what σ is)
     double f_bottom;     ///< ... on the die floor, N
     double f_side;       ///< sum of normal forces on the die's side wall, N
+    /// The whole force of the granules along the die's axis (−y is down, so
+    /// a wall pushed outwards by the bed reads +y for the piston, −y for the
+    /// floor), as the engine computed it (dem_world_wall_force: springs,
+    /// dashpots and friction): on the piston, the floor, and the side wall
+    /// (there only friction has an axial part: the load the die wall carries).
+    double f_piston_axial, f_floor_axial, f_side_axial;
     double sigma;        ///< f_top / die area, Pa
     double ke_over_elastic; ///< kinetic over elastic energy of the bed (quasi-static when small)
     int cycle;           ///< 1-based

@@ -119,6 +119,16 @@ static void test_cycles_against_independent_estimates(void **state)
     printf("at rest: piston %.4g N, floor %.4g N, weight %.3g N, side wall normal %.4g N (friction limit %.4g N)\n",
            top, bottom, weight, side, d.wall.mu_s * side);
     assert_true(fabs(top + weight - bottom) <= 1.05 * d.wall.mu_s * side + 0.02 * top);
+    // The same balance from the engine's own wall totals (springs, dashpots
+    // and friction: dem_world_wall_force), which name the side wall's share:
+    // piston + floor + side = −weight along y, up to the bed's own m·a
+    // (quasi-static); the side wall's share within its friction limit.
+    const double fp = last->f_piston_axial, ff = last->f_floor_axial, fs = last->f_side_axial;
+    printf("engine's totals at rest: piston %.4g N, floor %.4g N, side (friction) %.4g N; sum + weight %.3g N\n", fp,
+           ff, fs, fp + ff + fs + weight);
+    assert_true(fabs(fp + ff + fs + weight) < 0.01 * fabs(ff));
+    assert_true(fabs(fs) <= 1.05 * d.wall.mu_s * side);
+    assert_true(fabs(fp - top) < 0.05 * top); // the spring sum is most of it at rest
 
     // Dissipative hysteresis in every cycle; rearrangement dies out.
     for (int k2 = 0; k2 < r.n_cycles; ++k2) assert_true(r.cycle[k2].work_in >= r.cycle[k2].work_out);
