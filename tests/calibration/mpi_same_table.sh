@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# A small calibration (the PTFE wall alone, tier `check`) run on one process and with
-# `mpirun -np 2` gives the same table and the same measurement in every record.
-#   usage: mpi_same_table.sh GRANUCAL SOURCE_DIR WORK_DIR
+# A small calibration (the PTFE wall alone, tier `check`, or TIER) run on one process and with
+# `mpirun -np 2` gives the same table and the same measurement in every record. With
+# TIER=check-two-tier the two-tier search (its map tier's runs, then the deciding tier's) is
+# spread over the ranks as the standard tier's would be.
+#   usage: mpi_same_table.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]
 set -euo pipefail
-bin=$1 src=$2 work=$3
+bin=$1 src=$2 work=$3 tier=${4:-check}
 rm -rf "$work" && mkdir -p "$work"
 cd "$src"
-args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 1)
+args=(calibrate configs/calibration.yaml --tier "$tier" --material PTFE --jobs 1)
 "$bin" "${args[@]}" --out "$work/serial" > "$work/serial.log" 2>&1 || { cat "$work/serial.log"; exit 1; }
 mpi=(mpirun -np 2)
 [ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
@@ -17,4 +19,4 @@ strip() { cut -d, -f1-15,18-20 "$1"; } # wall, fill and memory columns aside
 diff <(strip "$work/serial/simulations.csv") <(strip "$work/mpi/simulations.csv")
 n=$(($(wc -l < "$work/serial/simulations.csv") - 1))
 grep -q "2 rank(s)" "$work/mpi/report.md" || { echo "the MPI run did not see 2 ranks"; exit 1; }
-echo "same table and the same $n simulations from 1 process and from 2 MPI ranks"
+echo "tier $tier: same table and the same $n simulations from 1 process and from 2 MPI ranks"
