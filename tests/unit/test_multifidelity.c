@@ -161,7 +161,7 @@ static void a_varying_bias_converges_within_noise(void **state)
 }
 
 // A bias that varies along v (log μr), as λ 4096 against the ci map did
-// (results/calibration-standard/): linear in the plane, so once three runs
+// (results/calibration-standard-L4096/): linear in the plane, so once three runs
 // span v the fitted correction is exact along it, and the loop ends agreeing
 // with its prediction, at the expensive optimum.
 static void a_bias_along_mu_r_is_fitted(void **state)
