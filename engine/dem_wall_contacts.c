@@ -36,8 +36,11 @@ static DEM_ALWAYS_INLINE int wall_contact_of(const dem_world *restrict w, const 
     const dem_vec3 n = t.normal, wi = w->omg[i];
     const dem_vec3 spin = dem_v3_scale(wall->def.axis, wall->def.spin);
     *lever = r - w->lever_factor * t.overlap;
-    // The wall surface moves at Ω × (c − axis point) at the contact point c.
-    const dem_vec3 v_wall = dem_v3_cross(spin, dem_v3_sub(t.point, wall->def.point));
+    // The wall surface moves at Ω × (c − axis point) at the contact point c,
+    // plus its translation where it has one (only then: a zero added could
+    // turn a −0 into +0, and a wall at rest keeps its results bit for bit).
+    dem_vec3 v_wall = dem_v3_cross(spin, dem_v3_sub(t.point, wall->def.point));
+    if (wall->translating) v_wall = dem_v3_add(v_wall, wall->def.velocity);
     s->normal = n;
     s->overlap = t.overlap;
     s->vrel = dem_v3_sub(dem_v3_add(w->vel[i], dem_v3_cross(dem_v3_scale(wi, *lever), n)), v_wall);

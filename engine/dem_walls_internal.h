@@ -18,6 +18,7 @@ typedef struct dem_wall {
     char name[32];
     dem_contact_coeffs coeffs;
     unsigned features;
+    int translating; // def.velocity is nonzero: the contacts add it (dem_world_set_wall_velocity)
     int hist_len;
     double *hist; // hist_len doubles per granule
     // Granules within one skin of this wall at the last list rebuild, in

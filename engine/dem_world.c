@@ -225,7 +225,17 @@ static int check_wall_geometry(dem_world *w, const dem_wall_def *d)
     if (d->kind != DEM_WALL_PLANE && !(d->radius > 0))
         return dem_world_set_error(w, "wall '%s': radius must be positive", d->name ? d->name : "");
     if (!isfinite(d->spin)) return dem_world_set_error(w, "wall '%s': spin must be finite", d->name ? d->name : "");
+    if (!dem_v3_isfinite(d->velocity))
+        return dem_world_set_error(w, "wall '%s': velocity must be finite", d->name ? d->name : "");
     return 0;
+}
+
+// Only a wall with a nonzero velocity adds it to its contacts' relative
+// velocity: adding a zero vector can turn a −0 into +0, and every result of a
+// wall at rest must stay the same bits.
+static int wall_translates(const dem_wall_def *d)
+{
+    return d->velocity.x != 0.0 || d->velocity.y != 0.0 || d->velocity.z != 0.0;
 }
 
 int dem_world_add_wall(dem_world *w, const dem_wall_def *def)
@@ -237,6 +247,7 @@ int dem_world_add_wall(dem_world *w, const dem_wall_def *def)
     wall->def = *def;
     snprintf(wall->name, sizeof wall->name, "%s", def->name ? def->name : "wall");
     wall->def.name = wall->name;
+    wall->translating = wall_translates(&wall->def);
     if (wall_set_contact(w, wall, &def->contact)) return -1;
     w->prepared = 0;
     return w->n_walls++;
@@ -264,6 +275,18 @@ dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point)
     if (no_wall(w, wall)) return DEM_ERR_INVALID;
     if (!dem_v3_isfinite(point)) return dem_world_set_error(w, "wall %d: point must be finite", wall), DEM_ERR_INVALID;
     w->walls[wall].def.point = point;
+    return DEM_OK;
+}
+
+// Not an invalidation either: like the point, the velocity is what the next
+// force evaluation sees.
+dem_status dem_world_set_wall_velocity(dem_world *w, int wall, dem_vec3 velocity)
+{
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
+    if (!dem_v3_isfinite(velocity))
+        return dem_world_set_error(w, "wall %d: velocity must be finite", wall), DEM_ERR_INVALID;
+    w->walls[wall].def.velocity = velocity;
+    w->walls[wall].translating = wall_translates(&w->walls[wall].def);
     return DEM_OK;
 }
 
@@ -404,7 +427,7 @@ void dem_world_describe_features(const dem_world *w, char *buf, size_t len)
         const dem_wall *wl = &w->walls[k];
         used += snprintf(buf + used, len - used, "; wall %s (%s%s): damping %s, tangential %s, rolling %s",
                          wl->name, (const char *[]){"plane", "disc", "cylinder"}[wl->def.kind],
-                         wl->def.spin != 0 ? ", moving" : "", wl->features & DEM_FEAT_DAMPING ? "on" : "off",
+                         wl->def.spin != 0 || wl->translating ? ", moving" : "", wl->features & DEM_FEAT_DAMPING ? "on" : "off",
                          wl->features & DEM_FEAT_TANGENTIAL ? "on" : "off",
                          wl->features & DEM_FEAT_ROLLING ? "on" : "off");
     }

@@ -43,8 +43,8 @@ typedef enum dem_wall_kind {
 } dem_wall_kind;
 
 /// Definition of a wall. A wall can spin about `axis` through `point` at
-/// `spin` rad/s (a rotating drum): its surface velocity at a contact point c
-/// is Ω × (c − point).
+/// `spin` rad/s (a rotating drum) and translate at `velocity`: its surface
+/// velocity at a contact point c is velocity + Ω × (c − point).
 typedef struct dem_wall_def {
     dem_wall_kind kind;
     dem_vec3 point;   ///< plane: a point on it; disc: its centre; cylinder: a point on the axis
@@ -52,6 +52,12 @@ typedef struct dem_wall_def {
     dem_vec3 axis;    ///< cylinder: unit axis; also the spin axis of any wall
     double radius;    ///< disc and cylinder radius, m
     double spin;      ///< angular velocity about `axis`, rad/s
+    /// Translational velocity of the wall's surface, m/s (default 0): it
+    /// enters the contacts' relative velocity (dashpot, tangential spring and
+    /// friction), not the wall's position; the caller moves the wall
+    /// (dem_world_set_wall_point) where the motion is not along its own
+    /// surface.
+    dem_vec3 velocity;
     dem_contact_params contact; ///< granule–this-wall contact parameters (Table 3)
     const char *name; ///< for messages, optional
 } dem_wall_def;
@@ -151,10 +157,19 @@ dem_status dem_world_set_wall_spin(dem_world *w, int wall, double spin);
 /// disc's centre, a point on a cylinder's axis) to `point`, e.g. before every
 /// step (a piston driven at a set speed). The step in progress ends with the
 /// forces already computed; the next force evaluation sees the wall where it
-/// now is, with its surface moving at its spin only (the move itself enters
-/// no relative velocity: a quasi-static drive). The lists are rebuilt once a
-/// wall has moved half a skin since they were built.
+/// now is, with its surface moving at its spin and its velocity
+/// (dem_world_set_wall_velocity) only: the move itself enters no relative
+/// velocity, so a driven wall should also be given the velocity it is moved
+/// at. The lists are rebuilt once a wall has moved half a skin since they
+/// were built.
 dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point);
+/// Prescribed wall motion: the wall's translational velocity (m/s), which the
+/// contact law sees as the wall surface's velocity (with the spin's); e.g. a
+/// piston's drive speed, or a conveyor plane moving along itself. The wall is
+/// not moved by it (dem_world_set_wall_point). A wall whose velocity is zero
+/// adds nothing to the relative velocity, so its results are those of a wall
+/// without the field, bit for bit.
+dem_status dem_world_set_wall_velocity(dem_world *w, int wall, dem_vec3 velocity);
 /// A wall's definition as it now is (point and spin included); NULL for no
 /// such wall.
 const dem_wall_def *dem_world_wall(const dem_world *w, int wall);
