@@ -121,11 +121,16 @@ static dem_world *create_die(const exp_compress_def *d, double gravity, char *er
 // The piston's height: its prescribed position, moved before every step.
 static double piston_y(const dem_world *w) { return dem_world_wall(w, WALL_PISTON)->point.y; }
 
-static dem_status move_piston(dem_world *w, double y)
+// Place the piston at height y, its surface moving at vy (m/s, along the
+// die's axis): the speed it is driven at, so that its contacts' dashpots and
+// friction see the relative velocity of granule and piston (a move alone is
+// not seen by the contact law). 0 where it is placed rather than driven.
+static dem_status move_piston(dem_world *w, double y, double vy)
 {
     dem_vec3 p = dem_world_wall(w, WALL_PISTON)->point;
     p.y = y;
-    return dem_world_set_wall_point(w, WALL_PISTON, p);
+    dem_status st = dem_world_set_wall_point(w, WALL_PISTON, p);
+    return st != DEM_OK ? st : dem_world_set_wall_velocity(w, WALL_PISTON, dem_v3(0, vy, 0));
 }
 
 // Spring forces on the piston, the floor and the side wall: the normal
@@ -214,7 +219,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
     double step_travel = d->piston_speed * dt;
     uint64_t per_sample = (uint64_t)(SAMPLE_STRAIN * d->depth / step_travel) + 1;
     double y = fmin(piston_y(w), bed_top(w) + 0.02 * dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda));
-    move_piston(w, y);
+    move_piston(w, y, 0.0);
     curve_buf c = {0};
     int loading = 1, cycle = 1, touched = 0, approaching = 1;
     double h0 = NAN, t0 = dem_world_time(w);
@@ -227,9 +232,10 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         // travels at APPROACH_FACTOR × the test speed until σ reaches a
         // quarter of σ_min (the Instron's approach), then at the test speed.
         double travel = approaching ? APPROACH_FACTOR * step_travel : step_travel;
+        const double speed = (approaching ? APPROACH_FACTOR : 1.0) * d->piston_speed;
         for (uint64_t s = 0; s < per_sample; ++s) {
             y += loading ? -travel : travel;
-            if (move_piston(w, y) != DEM_OK || dem_world_step(w, 1) != DEM_OK)
+            if (move_piston(w, y, loading ? -speed : speed) != DEM_OK || dem_world_step(w, 1) != DEM_OK)
                 return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
         }
         steps += per_sample;
@@ -277,6 +283,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         if (progress) progress(loading ? "load" : "unload", sm.t, dem_world_granules(w).count, ctx);
         if (sm.t > d->max_time) break;
     }
+    move_piston(w, y, 0.0); // the test is over: the piston stops where it is
     out->curve = c.s, out->n_curve = c.n;
     out->bed_height = h0;
     out->particle_steps = steps * dem_world_granules(w).count;
@@ -326,7 +333,7 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
     // The bed carries the overlaps of FILL_GRAVITY·g; released under g they
     // would launch granules (the default dashpot acts only on approach), so
     // the piston is lowered onto the bed first and the bed relaxes under it.
-    move_piston(w, bed_top(w) + 0.02 * dem_gsd_max_diameter(&gsd));
+    move_piston(w, bed_top(w) + 0.02 * dem_gsd_max_diameter(&gsd), 0.0);
     if (dem_world_prepare(w) != DEM_OK ||
         exp_run_until_rest(w, gsd.median_diameter, 1e-6, RELAX_MAX_TIME, CHECK_EVERY, progress, ctx, "relax")) {
         exp_fail(err, len, "%s", dem_world_error(w));
