@@ -391,10 +391,20 @@ static void write_convergence(FILE *o, const study *s)
         fprintf(o, "The coarsest rung within %g° and %g point of it is %s (λ %g). ", CONVERGED_ANGLE_DEG,
                 CONVERGED_CSA_PERCENT, coarsest->rung->name, coarsest->rung->lambda);
     else fprintf(o, "No other rung lies within %g° and %g point of it. ", CONVERGED_ANGLE_DEG, CONVERGED_CSA_PERCENT);
-    if (next && within_band(next))
-        fprintf(o, "The next coarser λ run (%s, λ %g) agrees with it within that band, so the ladder has levelled off "
-                   "there, as far as these seeds tell.\n",
-                next->rung->name, next->rung->lambda);
+    // Within the band is not enough: a difference the seeds resolve (over two
+    // standard errors of the difference) says the angle is still moving.
+    double se = next ? hypot(next->angle_se[0], ref->angle_se[0]) : NAN;
+    int resolved = next && isfinite(se) && se > 0 && next->angle_error > 2 * se;
+    if (next && within_band(next) && resolved)
+        fprintf(o, "The next coarser λ run (%s, λ %g) lies within that band, **but the angle is still moving**: it "
+                   "differs by %.2f ± %.2f° (%.1f standard errors of the difference), so the ladder has not been shown "
+                   "converged.\n",
+                next->rung->name, next->rung->lambda, next->angle_error, se, next->angle_error / se);
+    else if (next && within_band(next))
+        fprintf(o, "The next coarser λ run (%s, λ %g) agrees with it within that band (%.2f°, %s), so the ladder has "
+                   "levelled off there, as far as these seeds tell.\n",
+                next->rung->name, next->rung->lambda, next->angle_error,
+                isfinite(se) ? "within two standard errors of the difference" : "one seed: no spread");
     else if (next)
         fprintf(o, "**The ladder has not been shown converged:** between %s (λ %g) and %s (λ %g) the angle still moves "
                    "by %.2f° and the CSA by %.2f points.\n",
