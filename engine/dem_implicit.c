@@ -95,16 +95,14 @@ static void imp_pair_apply(dem_world *restrict w, const double *restrict x)
             const double *xi = x + 6 * i, *xj = x + 6 * (size_t)w->nl.j[k];
             const dem_vec3 du = dem_v3(xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]);
             const dem_vec3 ti = dem_v3(xi[3], xi[4], xi[5]), tj = dem_v3(xj[3], xj[4], xj[5]);
-            const double dn = dem_v3_dot(du, c->n);
-            // Contact-point slip (eq. 7) and rolling displacement (eq. 12) of x.
-            dem_vec3 slip = dem_v3_axpy(-dn, c->n, du);
-            slip = dem_v3_add(slip, dem_v3_cross(dem_v3_axpy(c->aj, tj, dem_v3_scale(ti, c->ai)), c->n));
-            const dem_vec3 roll = dem_v3_scale(dem_v3_cross(c->n, dem_v3_sub(ti, tj)), c->rs);
-            const dem_vec3 fs = dem_v3_scale(slip, cc * c->kt), fr = dem_v3_scale(roll, cc * c->kr);
-            const dem_vec3 ns = dem_v3_cross(c->n, fs), nr = dem_v3_scale(dem_v3_cross(c->n, fr), c->rs);
-            w->imp->pf[k] = dem_v3_axpy(dt * c->g * dn, c->n, fs);
-            w->imp->pti[k] = dem_v3_sub(dem_v3_scale(ns, c->ai), nr);
-            w->imp->ptj[k] = dem_v3_add(dem_v3_scale(ns, c->aj), nr);
+            // The dashpot along n, the sticking springs on the slip and roll
+            // of x (the block of imp_blocks_and_rhs is this operator's).
+            const dem_linear_contact l = {.n = c->n, .ai = c->ai, .aj = c->aj, .rs = c->rs, .kn = dt * c->g,
+                                          .kt = c->kt, .kr = c->kr, .c = cc};
+            const dem_linear_response r = dem_linear_contact_apply(&l, du, ti, tj);
+            w->imp->pf[k] = r.f;
+            w->imp->pti[k] = r.torque_i;
+            w->imp->ptj[k] = r.torque_j;
         }
 }
 

@@ -6,6 +6,7 @@
 #ifndef DEM_IMPLICIT_INTERNAL_H
 #define DEM_IMPLICIT_INTERNAL_H
 
+#include "dem_linear_contact_internal.h"
 #include "dem_state_internal.h"
 
 // One contact as the implicit spring solve sees it: normal, dashpot γ
@@ -30,26 +31,14 @@ struct dem_implicit {
 
 // One contact's part of the 6×6 diagonal block (v, ω) of Δt·C + Δt²/4·K_t for
 // the granule whose unit normal (towards the partner) is n and lever arm a:
-//   vv: Δt γ n nᵀ + c k_t T            vω: −c k_t a [n]×
-//   ωv: c k_t a [n]×                   ωω: c (k_t a² + k_r R*²) T
-// with c = Δt²/4, T = I − n nᵀ, [n]× the cross-product matrix. It is the
-// linearisation of eq. 3–4 (dashpot), 6–7 and 9 (tangential spring on the
-// contact-point slip) and 10–12 (rolling spring on −R*(ω_i − ω_j) × n). The
-// partner's block has the same form with −n. Row-major, full 6×6.
+// the linearised contact (dem_linear_contact_internal.h) with the dashpot γ
+// applied as its normal part (Δt·γ) and the sticking springs at c = Δt²/4.
 static inline void dem_imp_add_block(double *b, dem_vec3 n, double g, double kt, double kr, double a, double rs,
                                      double dt)
 {
-    const double c = 0.25 * dt * dt, nv[3] = {n.x, n.y, n.z};
-    const double cross[3][3] = {{0, -n.z, n.y}, {n.z, 0, -n.x}, {-n.y, n.x, 0}};
-    const double rot = c * (kt * a * a + kr * rs * rs);
-    for (int r = 0; r < 3; ++r)
-        for (int q = 0; q < 3; ++q) {
-            double t = (r == q) - nv[r] * nv[q];
-            b[6 * r + q] += dt * g * nv[r] * nv[q] + c * kt * t;
-            b[6 * r + q + 3] -= c * kt * a * cross[r][q];
-            b[6 * (r + 3) + q] += c * kt * a * cross[r][q];
-            b[6 * (r + 3) + q + 3] += rot * t;
-        }
+    const dem_linear_contact l = {.n = n, .ai = a, .aj = 0.0, .rs = rs, .kn = dt * g, .kt = kt, .kr = kr,
+                                  .c = 0.25 * dt * dt};
+    dem_linear_contact_add_block(b, &l);
 }
 
 // Before a force evaluation: whether the loops are to hand the solve their

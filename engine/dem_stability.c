@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_linear_contact_internal.h" // the contact operator K of apply()
+
 #define POWER_ITERATIONS 200
 #define LATTICE_CELLS 4
 
@@ -46,17 +48,11 @@ static void apply(const dem_contact_network *net, const dof6 *x, dof6 *y, enum o
             f = dem_v3_scale(n, 2 * g->p->xi * sqrt(g->mstar * g->p->k_n) * dem_v3_dot(du, n));
         } else if (op == OP_NORMAL) {
             f = dem_v3_scale(n, g->p->k_n * dem_v3_dot(du, n));
-        } else {
-            f = dem_v3_scale(n, g->p->k_n * dem_v3_dot(du, n));
-            dem_vec3 slip = dem_v3_add(dem_v3_axpy(-dem_v3_dot(du, n), n, du),
-                                       dem_v3_cross(dem_v3_add(dem_v3_scale(ti, g->ai), dem_v3_scale(tj, g->aj)), n));
-            dem_vec3 fs = dem_v3_scale(slip, g->p->k_s); // restoring force on i is −fs
-            dem_vec3 roll = dem_v3_scale(dem_v3_cross(dem_v3_sub(ti, tj), n), -g->rstar);
-            dem_vec3 fr = dem_v3_scale(roll, g->p->k_r);
-            f = dem_v3_add(f, fs);
-            dem_vec3 ts = dem_v3_cross(n, fs), tr = dem_v3_scale(dem_v3_cross(n, fr), g->rstar);
-            torque_i = dem_v3_sub(dem_v3_scale(ts, g->ai), tr);
-            torque_j = dem_v3_add(dem_v3_scale(ts, g->aj), tr);
+        } else { // every spring sticking, at its own stiffness
+            const dem_linear_contact l = {.n = n, .ai = g->ai, .aj = g->aj, .rs = g->rstar, .kn = g->p->k_n,
+                                          .kt = g->p->k_s, .kr = g->p->k_r, .c = 1.0};
+            const dem_linear_response r = dem_linear_contact_apply(&l, du, ti, tj);
+            f = r.f, torque_i = r.torque_i, torque_j = r.torque_j;
         }
         y[i].u = dem_v3_axpy(si, f, y[i].u);
         y[i].t = dem_v3_axpy(ri, torque_i, y[i].t);
