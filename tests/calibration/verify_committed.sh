@@ -3,7 +3,8 @@
 #  1. the table re-derived from the committed store, by the calibration's own command (report.md),
 #     is the committed calibrated_parameters.csv byte for byte, and no simulation runs;
 #  2. N of the simulations that command used, picked at random (the pick's seed is printed: rerun
-#     with SEED=... to repeat it), are removed from a copy of the store and run again; each must
+#     with SEED=... to repeat it; for a two-tier calibration half of them, rounded up, from the
+#     deciding tier's runs and the rest from the map tier's), are removed from a copy of the store and run again; each must
 #     reproduce its committed record's measurements exactly (one thread a simulation: the engine is
 #     deterministic, and its results do not depend on the CPU), and the table must come out the same.
 #   usage: verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
@@ -43,15 +44,26 @@ else
   fails=$((fails + 1))
 fi
 
-# The drum records this command's stages used (simulations.csv: stage, candidate, record, experiment, ...).
-case $stage in
-  granule) keep='$1 == "granule"' ;;
-  wall) keep='$1 != "granule" && $1 != "stiffness"' ;;
-  *) keep='1' ;;
-esac
+# The drum records this command's stages used (simulations.csv: stage, candidate, record, experiment,
+# ...; a two-tier stage lists its map tier's runs as "NAME (map)").
 seed=${SEED:-$(date +%s)}
-mapfile -t picked < <(awk -F, "NR > 1 && \$4 == \"drum\" && ($keep) { print \$3 }" "$results/simulations.csv" | sort -u |
-  shuf -n "$n" --random-source=<(yes "$seed"))
+# records STAGES TIER: STAGES granule|wall|all, TIER map|deciding|any.
+records() {
+  awk -F, -v stages="$1" -v tier="$2" 'NR > 1 && $4 == "drum" {
+    s = $1; map = sub(/ \(map\)$/, "", s)
+    if (stages == "granule" && s != "granule") next
+    if (stages == "wall" && (s == "granule" || s == "stiffness")) next
+    if ((tier == "map" && !map) || (tier == "deciding" && map)) next
+    print $3 }' "$results/simulations.csv" | sort -u
+}
+pick() { shuf -n "$1" --random-source=<(yes "$seed"); }
+# Two tiers: half the picks (rounded up) from the deciding tier, so a run of the expensive drum is
+# always among them, the rest from the map tier.
+if [ -n "$(records "$stage" map)" ]; then
+  mapfile -t picked < <(records "$stage" deciding | pick $(((n + 1) / 2)); records "$stage" map | pick $((n / 2)))
+else
+  mapfile -t picked < <(records "$stage" any | pick "$n")
+fi
 echo "picked at random (SEED=$seed): ${picked[*]}"
 [ "${#picked[@]}" -eq "$n" ] || { echo "FAIL: fewer than $n drum records to pick from"; exit 1; }
 for h in "${picked[@]}"; do rm "$work/out/store/$h.yaml"; done
