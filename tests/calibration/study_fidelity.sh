@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `granucal study fidelity` end to end on a tiny ladder: two cheap rungs run, a Table B.1
 # rung (lambda 8, full drum) is over the budget and listed with a predicted cost instead;
-# the finest rung run is the reference (error 0), the other has a finite error; a rerun
+# the finest rung run has error 0 (errors are against it), the other a finite one; a rerun
 # recomputes nothing. Then the committed ladder (results/fidelity_ladder/store) is read back at 4 rpm
 # and must be called still moving between lambda 1000 and 512.
 #   usage: study_fidelity.sh GRANUCAL SOURCE_DIR WORK_DIR
