@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
-// `granucal simulate SCENE.yaml`: run an explicit scene and write what it did.
+// `granucal simulate FILE.yaml`: the one home of its runners. An experiment
+// config (drum, compression, silo, cylinder) goes to its runner through
+// simulate_runners; anything else is an explicit scene, run here and written
+// out frame by frame.
 #include <getopt.h>
 #include <libgen.h>
 #include <stdint.h>
@@ -159,42 +162,31 @@ static int finish(const char *dir, sim_outputs *o, const exp_scene *s, dem_world
     return bad || st != DEM_OK ? 1 : 0;
 }
 
-int cal_cmd_simulate(int argc, char **argv)
+// What `granucal simulate` hands every runner: the options as given.
+typedef struct simulate_args {
+    int n_sets;
+    char **sets;     // --set KEY=VALUE overrides
+    const char *out; // --out DIR, or NULL for the runner's default
+    const char *rpm_list;
+    double checkpoint_every_s;
+} simulate_args;
+
+// The plain scene (granules and walls listed one by one): the runner when no
+// experiment claims the file.
+static int run_scene_file(const char *path, const simulate_args *a)
 {
-    static const struct option opts[] = {{"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'},
-                                         {"rpm-list", required_argument, 0, 'r'},
-                                         {"checkpoint-every", required_argument, 0, 'c'},
-                                         {"help", no_argument, 0, 'h'}, {0}};
-    const char *out = NULL, *rpm_list = NULL;
-    double checkpoint_every_s = CAL_CHECKPOINT_EVERY_S;
-    char *sets[64];
-    int n_sets = 0, c;
-    while ((c = getopt_long(argc, argv, "o:s:h", opts, NULL)) != -1) {
-        if (c == 'h') return fputs(simulate_help, stdout), 0;
-        if (c == 'o') out = optarg;
-        else if (c == 's' && n_sets < 64) sets[n_sets++] = optarg;
-        else if (c == 'r') rpm_list = optarg;
-        else if (c == 'c') {
-            if (cal_parse_checkpoint_every("simulate", optarg, &checkpoint_every_s)) return 2;
-        } else return fputs(simulate_help, stderr), 2;
-    }
-    if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
-    if (exp_is_drum_config(argv[optind])) return cal_simulate_drum(argv[optind], n_sets, sets, out, rpm_list, checkpoint_every_s);
-    if (exp_is_compress_config(argv[optind])) return exp_compress_simulate(argv[optind], n_sets, sets, out);
-    if (exp_is_silo_config(argv[optind])) return exp_silo_simulate(argv[optind], n_sets, sets, out);
-    if (exp_is_cylinder_config(argv[optind])) return exp_cylinder_simulate(argv[optind], n_sets, sets, out);
-    if (n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
+    if (a->n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
     char err[1024], dir[1024];
-    exp_scene *s = exp_scene_load(argv[optind], err, sizeof err);
+    exp_scene *s = exp_scene_load(path, err, sizeof err);
     if (!s) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    snprintf(dir, sizeof dir, "%s", out ? out : "");
-    if (!out) snprintf(dir, sizeof dir, "results/runs/%s", s->name);
+    snprintf(dir, sizeof dir, "%s", a->out ? a->out : "");
+    if (!a->out) snprintf(dir, sizeof dir, "results/runs/%s", s->name);
     dem_world *w = exp_scene_build(s, err, sizeof err);
-    if (!w) return fprintf(stderr, "granucal simulate: %s: %s\n", argv[optind], err), exp_scene_free(s), 1;
+    if (!w) return fprintf(stderr, "granucal simulate: %s: %s\n", path, err), exp_scene_free(s), 1;
     int rc = 1;
     sim_outputs o = {0};
     if (dem_world_prepare(w) != DEM_OK) {
-        fprintf(stderr, "granucal simulate: %s: %s\n", argv[optind], dem_world_error(w));
+        fprintf(stderr, "granucal simulate: %s: %s\n", path, dem_world_error(w));
     } else if (open_outputs(&o, dir, err, sizeof err)) {
         fprintf(stderr, "granucal simulate: %s\n", err);
     } else {
@@ -207,4 +199,61 @@ int cal_cmd_simulate(int argc, char **argv)
     dem_world_destroy(w);
     exp_scene_free(s);
     return rc;
+}
+
+// The experiments' runners, one per experiment, each the same shape. The
+// drum's is calib's own (cal_drum.c: its runs are keyed like the
+// calibration's store, and it takes --rpm-list and --checkpoint-every); the
+// others live with their experiment (experiments/exp_*), which knows nothing
+// of calib.
+static int run_drum(const char *path, const simulate_args *a)
+{
+    return cal_simulate_drum(path, a->n_sets, a->sets, a->out, a->rpm_list, a->checkpoint_every_s);
+}
+static int run_compress(const char *path, const simulate_args *a)
+{
+    return exp_compress_simulate(path, a->n_sets, a->sets, a->out);
+}
+static int run_silo(const char *path, const simulate_args *a) { return exp_silo_simulate(path, a->n_sets, a->sets, a->out); }
+static int run_cylinder(const char *path, const simulate_args *a)
+{
+    return exp_cylinder_simulate(path, a->n_sets, a->sets, a->out);
+}
+
+// Every experiment `granucal simulate` runs: the first whose `claims` knows
+// the file (its first key, `experiment: NAME`) runs it; a file none claims
+// is a plain scene.
+static const struct simulate_runner {
+    int (*claims)(const char *path);
+    int (*run)(const char *path, const simulate_args *a);
+} simulate_runners[] = {
+    {exp_is_drum_config, run_drum},
+    {exp_is_compress_config, run_compress},
+    {exp_is_silo_config, run_silo},
+    {exp_is_cylinder_config, run_cylinder},
+};
+
+int cal_cmd_simulate(int argc, char **argv)
+{
+    static const struct option opts[] = {{"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'},
+                                         {"rpm-list", required_argument, 0, 'r'},
+                                         {"checkpoint-every", required_argument, 0, 'c'},
+                                         {"help", no_argument, 0, 'h'}, {0}};
+    char *sets[64];
+    simulate_args a = {.sets = sets, .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
+    int c;
+    while ((c = getopt_long(argc, argv, "o:s:h", opts, NULL)) != -1) {
+        if (c == 'h') return fputs(simulate_help, stdout), 0;
+        if (c == 'o') a.out = optarg;
+        else if (c == 's' && a.n_sets < 64) sets[a.n_sets++] = optarg;
+        else if (c == 'r') a.rpm_list = optarg;
+        else if (c == 'c') {
+            if (cal_parse_checkpoint_every("simulate", optarg, &a.checkpoint_every_s)) return 2;
+        } else return fputs(simulate_help, stderr), 2;
+    }
+    if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
+    const char *path = argv[optind];
+    for (size_t k = 0; k < sizeof simulate_runners / sizeof *simulate_runners; ++k)
+        if (simulate_runners[k].claims(path)) return simulate_runners[k].run(path, &a);
+    return run_scene_file(path, &a);
 }
