@@ -174,8 +174,8 @@ def main():
         print("engine layering: %d problem(s)" % len(failing))
         print("\n".join(line for b in failing for line in b))
         return 1
-    print("engine layering: %d modules; %s include cycle, private header used outside engine/%s"
-          % (len(graph), "no other" if known else "no", " or call cycle" if len(sys.argv) == 3 else ""))
+    print("engine layering: %d modules; %s include cycle, no private header used outside engine/%s"
+          % (len(graph), "no other" if known else "no", ", no call cycle" if len(sys.argv) == 3 else ""))
     return 0
 
 
