@@ -385,8 +385,11 @@ static void draw_markers_and_names(const exp_plot_series *s, int log_x, int log_
         if (!isfinite(x) || !isfinite(y)) continue;
         if (s->style != EXP_PLOT_LINE) mark(x, y, s->marker);
         if (s->names && s->names[i]) {
-            // beside the point, on the side with room for it (text past the axes is clipped)
+            // beside the point, on the side with room for it (text past the axes is clipped),
+            // and on the other side from an earlier named point at the same x (two rungs of one λ)
             int left = x - xr.lo > 0.7 * (xr.hi - xr.lo);
+            for (size_t j = 0; j < i; ++j)
+                if (s->names[j] && fabs(world(s->x[j], log_x) + shift - x) < 0.01 * (xr.hi - xr.lo)) left = !left;
             text_size(SMALL);
             plptex(x + (left ? -0.015 : 0.015) * (xr.hi - xr.lo), y, 1, 0, left ? 1.0 : 0.0, s->names[i]);
             text_size(TEXT);
