@@ -389,19 +389,35 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 // (results/benchmarks/drum_end_to_end.md); a prediction, not a promise.
 static const double predicted_rate = 8.5e6;
 
-// The drum runs the plan may take, predicted before the first one: core-hours,
-// wall hours on the workers, one simulation's memory. A plan that cannot fit
-// the memory left, or the --budget-hours given, is refused with these numbers.
+// Stage 1's poured cylinders: one per stiffness candidate and seed, the
+// stiffer ones dearer (a smaller step).
+static double cylinders_core_s(const run *r, double *memory_mb)
+{
+    double core_s = 0;
+    for (unsigned k = 0; k < r->c->stiffness_count; ++k) {
+        exp_cylinder_def d = cal_cylinder_case_make(r->c, r->t, r->c->stiffness[k], 1);
+        exp_cylinder_cost c = exp_cylinder_predict_cost(&d);
+        core_s += r->t->seeds * c.particle_steps / predicted_rate;
+        *memory_mb = fmax(*memory_mb, c.memory_mb);
+    }
+    return core_s;
+}
+
+// The simulations the plan may take, predicted before the first one:
+// core-hours, wall hours on the workers, one simulation's memory. A plan that
+// cannot fit the memory left, or the --budget-hours given, is refused with
+// these numbers.
 static int check_predicted_cost(run *r)
 {
     double core_s = 0, memory_mb = 0;
-    int runs = 0;
+    int runs = 0, cylinders = 0;
     for (int k = 0; k < r->progress.n_stages; ++k) {
         const cal_progress_stage *s = &r->progress.stage[k];
-        const cal_tier *t = s->kind == CAL_RUN_MAP_DRUM ? cal_config_tier_named(r->c, r->t->map_tier)
-                            : s->kind == CAL_RUN_DRUM   ? r->t
-                                                        : NULL;
-        if (!t) continue; // stage 1's cylinders: small beside the drum runs
+        if (s->kind == CAL_RUN_CYLINDER) {
+            core_s += cylinders_core_s(r, &memory_mb), cylinders += s->planned;
+            continue;
+        }
+        const cal_tier *t = s->kind == CAL_RUN_MAP_DRUM ? cal_config_tier_named(r->c, r->t->map_tier) : r->t;
         cal_drum_case d = cal_drum_case_granule(r->c, t, r->c->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
         exp_drum_cost c = exp_drum_predict_cost(&d.def, t->max_time);
         double rpm[CAL_MAX_RPM]; // a bed settles once for the speeds it is turned at
@@ -410,11 +426,13 @@ static int check_predicted_cost(run *r)
         core_s += (s->planned * c.turn_particle_steps + (double)s->planned / speeds * c.fill_particle_steps) / predicted_rate;
         memory_mb = fmax(memory_mb, c.memory_mb), runs += s->planned;
     }
-    int parallel = r->env.workers * cal_mpi_size();
-    double wall_h = core_s / 3600 / (parallel < runs ? parallel : runs > 0 ? runs : 1);
+    int parallel = r->env.workers * cal_mpi_size(), all = runs + cylinders;
+    double wall_h = core_s / 3600 / (parallel < all ? parallel : all > 0 ? all : 1);
     char what[256];
-    snprintf(what, sizeof what, "at most %d drum runs, predicted %.2g core-hours (%.2g h on %d worker(s)), %.0f MB a run",
-             runs, core_s / 3600, wall_h, parallel, memory_mb);
+    snprintf(what, sizeof what,
+             "at most %d drum runs and %d poured cylinders, predicted %.2g core-hours (%.2g h on %d worker(s)), %.0f MB "
+             "a simulation",
+             runs, cylinders, core_s / 3600, wall_h, parallel, memory_mb);
     fprintf(stderr, "== plan: %s\n", what);
     long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
     double free_mb = pages > 0 && page > 0 ? (double)pages * (double)page / 1048576 : INFINITY;

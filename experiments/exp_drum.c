@@ -27,9 +27,7 @@ exp_drum_cost exp_drum_predict_cost(const exp_drum_def *d, double max_time)
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     double r = 0.5 * d->diameter, bed_volume = d->fill * DEM_PI * r * r * d->depth;
     double n = (double)dem_gsd_count_for_volume(&gsd, poured_fraction * bed_volume);
-    double d_min = dem_gsd_min_diameter(&gsd);
-    double m_min = dem_scale_density(d->density, d->lambda) * DEM_PI / 6 * d_min * d_min * d_min;
-    double dt_crit = sqrt(m_min / dem_scale_stiffness(d->granule.k_n, d->lambda)); // eq. 14
+    double dt_crit = exp_lightest_dt_crit(&d->gsd, d->density, d->granule.k_n, d->lambda);
     return (exp_drum_cost){.granules = n,
                            .fill_particle_steps = n * fill_time / (fill_fraction * dt_crit),
                            .turn_particle_steps = n * max_time / (turn_fraction * dt_crit),

@@ -66,6 +66,8 @@ expect "extra fields, CSA file" "extra_csa.csv:3: row: has 7 fields, expected 4"
 expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
 expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
 expect "a plan over the budget" "over --budget-hours 0.001: nothing was run" -- "$work/configs/good.yaml" --tier ci --budget-hours 0.001 "${out[@]}"
+# Stage 1 alone has no drum run: its poured cylinders are predicted and refused too.
+expect "stage 1 over the budget" "0 drum runs and 10 poured cylinders" -- "$work/configs/good.yaml" --tier ci --stage stiffness --budget-hours 0.0001 "${out[@]}"
 expect "a budget not a number" "--budget-hours 'soon'" -- "$work/configs/good.yaml" --budget-hours soon "${out[@]}"
 expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
 expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
