@@ -170,6 +170,9 @@ static void test_shipped_config_loads(void **state)
     assert_string_equal(map->name, "ci");
     assert_int_equal(cal_tier_beds(map), 2);
     assert_int_equal(map->rpm_count, standard->rpm_count);
+    // its 4 rpm drum avalanches and is averaged 8 s, the fast speeds flow and are averaged 2 s
+    assert_true(cal_tier_average_time(standard, 4) == 8 && cal_tier_average_time(standard, 40) == 2 &&
+                cal_tier_average_time(standard, 116) == 2);
     cal_config_free(c);
 }
 
