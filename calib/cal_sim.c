@@ -42,9 +42,9 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     d.def = exp_drum_def_from_physics(&p);
     d.run = exp_default_drum_run_opts();
     d.run.average_time = t->average_time;
-    d.n_average = 0;
-    for (unsigned k = 0; k < t->average_time_per_rpm_count && k < t->rpm_count && k < CAL_CASE_MAX_RPM; ++k)
-        d.average_rpm[d.n_average] = t->rpm[k], d.average_time[d.n_average++] = t->average_time_per_rpm[k];
+    d.n_average = 0; // each of the tier's speeds with its own averaging time, if it gives them
+    for (unsigned k = 0; k < t->rpm_count && k < CAL_CASE_MAX_RPM && t->average_time_per_rpm_count; ++k)
+        d.average_rpm[d.n_average] = t->rpm[k], d.average_time[d.n_average++] = cal_tier_average_time(t, t->rpm[k]);
     d.run.max_time = t->max_time, d.run.window = t->window;
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
     if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
