@@ -4,13 +4,15 @@
 # (issue 22; the rules are explained in the tolerances file's header).
 #
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv > comparison.md
+#   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv --expect COMMITTED.md
 #
 # RUN_DIR holds calibrated_parameters.csv (value, not_excluded_min/max) and calibrated_parameters.md
 # (its Source column says whether stage 1 resolved the stiffness). Prints one row per tolerance
 # entry and a summary; exit status 0 when it could compare (whatever the verdicts), 2 on bad input.
 # CI regenerates this comparison from the committed run and checks it is the committed one, so a
-# verdict can change only with the table or the tolerances, in a commit that says so.
-import csv, math, sys
+# verdict can change only with the table or the tolerances, in a commit that says so: with --expect
+# it prints nothing but a difference, and exits 1 when the comparison is not the committed one.
+import csv, difflib, io, math, sys
 
 
 def rows(path):
@@ -49,7 +51,7 @@ def judge(rule, tol, paper, got, row, resolved):
         ratio = max(value, paper) / min(value, paper)
         return ('pass' if ratio <= tol else 'FAIL'), 'factor %.3g' % ratio
     if rule == 'inside':
-        lo, hi = got['not_excluded_min'], got['not_excluded_max']
+        lo, hi = got.get('not_excluded_min', ''), got.get('not_excluded_max', '')
         if lo == '' or hi == '':
             return 'FAIL', 'no interval'
         lo, hi = float(lo) / tol, float(hi) * tol
@@ -58,10 +60,35 @@ def judge(rule, tol, paper, got, row, resolved):
 
 
 def main():
-    if len(sys.argv) != 4:
-        print(__doc__ or 'usage: compare_table3.py RUN_DIR PAPER_TABLE3 TOLERANCES', file=sys.stderr)
+    args = sys.argv[1:]
+    expect = None
+    if len(args) == 5 and args[3] == '--expect':
+        expect = args.pop(4)
+        args.pop(3)
+    if len(args) != 3:
+        print('usage: compare_table3.py RUN_DIR PAPER_TABLE3 TOLERANCES [--expect COMMITTED.md]', file=sys.stderr)
         return 2
-    run_dir, paper_path, tol_path = sys.argv[1:]
+    if expect is None:
+        return compare(*args, out=sys.stdout)
+    text = io.StringIO()
+    status = compare(*args, out=text)
+    if status:
+        return status
+    try:
+        with open(expect) as f:
+            committed = f.read()
+    except OSError as e:
+        print('compare_table3.py: %s' % e, file=sys.stderr)
+        return 2
+    if committed == text.getvalue():
+        print('ok   the comparison with Table 3 is the committed %s' % expect)
+        return 0
+    sys.stdout.writelines(difflib.unified_diff(committed.splitlines(True), text.getvalue().splitlines(True),
+                                               expect, 'regenerated'))
+    return 1
+
+
+def compare(run_dir, paper_path, tol_path, out):
     try:
         paper = {key(r): float(r['value']) for r in rows(paper_path)}
         table = {key(r): r for r in rows(run_dir + '/calibrated_parameters.csv')}
@@ -70,8 +97,8 @@ def main():
     except (OSError, KeyError, ValueError) as e:
         print('compare_table3.py: %s' % e, file=sys.stderr)
         return 2
-    print('| contact | material | parameter | Table 3 | calibrated | rule | tolerance | measured | verdict |')
-    print('|---|---|---|---|---|---|---|---|---|')
+    print('| contact | material | parameter | Table 3 | calibrated | rule | tolerance | measured | verdict |', file=out)
+    print('|---|---|---|---|---|---|---|---|---|', file=out)
     counts = {}
     for t in tolerances:
         k = key(t)
@@ -81,9 +108,9 @@ def main():
         verdict, measured = judge(t['rule'], float(t['tolerance']), paper[k], table[k], t, resolved)
         counts[verdict] = counts.get(verdict, 0) + 1
         print('| %s | %s | %s | %g | %s | %s | %s | %s | %s |' % (k[0], k[1], k[2], paper[k], table[k]['value'],
-                                                              t['rule'], t['tolerance'], measured, verdict))
-    print()
-    print('Verdicts: ' + ', '.join('%d %s' % (n, v) for v, n in sorted(counts.items())) + '.')
+                                                              t['rule'], t['tolerance'], measured, verdict), file=out)
+    print(file=out)
+    print('Verdicts: ' + ', '.join('%d %s' % (n, v) for v, n in sorted(counts.items())) + '.', file=out)
     return 0
 
 

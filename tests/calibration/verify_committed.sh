@@ -7,7 +7,10 @@
 #     deciding tier's runs and the rest from the map tier's), are removed from a copy of the store and run again; each must
 #     reproduce its committed record's measurements exactly (one thread a simulation: the engine is
 #     deterministic, and its results do not depend on the CPU), and the table must come out the same.
-#   usage: verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
+#     With MAX_RERUN_S set, the picks are drawn only among the records whose own recorded wall time is
+#     at most that many seconds (a converged drum's slowest runs take 20 minutes; CI has less), and
+#     the script says how many records that left to draw from.
+#   usage: [MAX_RERUN_S=S] [SEED=N] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
 # files, and, for a run made with --data, the data files it read.
 set -euo pipefail
@@ -54,7 +57,15 @@ records() {
     if (stages == "granule" && s != "granule") next
     if (stages == "wall" && (s == "granule" || s == "stiffness")) next
     if ((tier == "map" && !map) || (tier == "deciding" && map)) next
-    print $3 }' "$results/simulations.csv" | sort -u
+    print $3 }' "$results/simulations.csv" | sort -u | affordable
+}
+# affordable: the records read on stdin whose recorded wall time is at most MAX_RERUN_S (all without it).
+affordable() {
+  while read -r h; do
+    [ -z "${MAX_RERUN_S:-}" ] ||
+      awk -v cap="$MAX_RERUN_S" '/^wall_time_s:/ { exit !($2 <= cap) }' "$results/store/$h.yaml" || continue
+    echo "$h"
+  done
 }
 pick() { shuf -n "$1" --random-source=<(yes "$seed"); }
 # Two tiers: half the picks (rounded up) from the deciding tier, so a run of the expensive drum is
@@ -64,6 +75,7 @@ if [ -n "$(records "$stage" map)" ]; then
 else
   mapfile -t picked < <(records "$stage" any | pick "$n")
 fi
+[ -z "${MAX_RERUN_S:-}" ] || echo "drawn among the $(records "$stage" any | wc -l) drum records of at most $MAX_RERUN_S s of recorded wall time"
 echo "picked at random (SEED=$seed): ${picked[*]}"
 [ "${#picked[@]}" -eq "$n" ] || { echo "FAIL: fewer than $n drum records to pick from"; exit 1; }
 for h in "${picked[@]}"; do rm "$work/out/store/$h.yaml"; done
