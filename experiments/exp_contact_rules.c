@@ -2,11 +2,8 @@
 // The paper's contact-pair rules (see exp_contact_rules.h).
 #include "exp_contact_rules.h"
 
-#include <math.h>
 #include <string.h>
 
-#include "dem_scaling.h"
-#include "dem_vec.h"
 #include "exp_common.h"
 
 int exp_damping_from_name(const char *name, const char *field, dem_damping_mode *out, char *err, size_t len)
@@ -37,12 +34,4 @@ double exp_boundary_stiffness(double granule_k_n) { return 2 * granule_k_n; }
 dem_contact_params exp_boundary_pair(const dem_contact_params *granule, double mu_s, double mu_r)
 {
     return pair(exp_boundary_stiffness(granule->k_n), granule->xi, mu_s, mu_r, granule->damping);
-}
-
-double exp_lightest_dt_crit(const dem_gsd *real_gsd, double real_density, double real_k_n, double lambda)
-{
-    dem_gsd gsd = dem_scale_gsd(real_gsd, lambda);
-    double d_min = dem_gsd_min_diameter(&gsd);
-    double m_min = dem_scale_density(real_density, lambda) * DEM_PI / 6 * d_min * d_min * d_min;
-    return sqrt(m_min / dem_scale_stiffness(real_k_n, lambda)); // eq. 14
 }

@@ -11,7 +11,6 @@
 #include <stddef.h>
 
 #include "dem_contact.h"
-#include "dem_gsd.h"
 
 /// The reading of eq. 4's dashpot a config gets when it names none (docs/model.md,
 /// "The contact model": damped while approaching, never pulling granules together).
@@ -31,10 +30,5 @@ double exp_boundary_stiffness(double granule_k_n);
 /// Table 3's granule–boundary pair: the boundary's stiffness for all three
 /// springs, the granule pair's ξ and damping, the boundary's own friction.
 dem_contact_params exp_boundary_pair(const dem_contact_params *granule, double mu_s, double mu_r);
-
-/// Eq. 14's critical step, sqrt(m/k_n), of the lightest granule of a real GSD
-/// coarse-grained by λ (eq. 15-18): what a scene's step is a fraction of, for
-/// predicting its cost before it runs.
-double exp_lightest_dt_crit(const dem_gsd *real_gsd, double real_density, double real_k_n, double lambda);
 
 #endif

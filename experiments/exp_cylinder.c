@@ -7,6 +7,7 @@
 
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
+#include "exp_cost.h"
 #include "exp_pour.h"
 
 #define LAYER_KE_RATIO 1e-2
@@ -32,15 +33,14 @@ exp_cylinder_def exp_default_cylinder_def(void)
 
 exp_cylinder_cost exp_cylinder_predict_cost(const exp_cylinder_def *d)
 {
-    const double solid_fraction = 0.535, pour_time = 3.0, step_fraction = 0.165;
-    const double base_mb = 9.5, mb_per_granule = 2.1e-3; // as a drum's (exp_drum_predict_cost)
+    const double solid_fraction = 0.535, pour_time = 3.0;
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     double r = 0.5 * d->diameter, volume = DEM_PI * r * r * d->depth;
     double n = (double)dem_gsd_count_for_volume(&gsd, solid_fraction * volume);
     double dt_crit = exp_lightest_dt_crit(&d->gsd, d->density, d->granule.k_n, d->lambda);
     return (exp_cylinder_cost){.granules = n,
-                               .particle_steps = n * pour_time / (step_fraction * dt_crit),
-                               .memory_mb = base_mb + mb_per_granule * n};
+                               .particle_steps = n * pour_time / (EXP_POUR_STEP_FRACTION * dt_crit),
+                               .memory_mb = exp_predicted_peak_memory_mb(n)};
 }
 
 static dem_world *create_container(const exp_cylinder_def *d, char *err, size_t len)

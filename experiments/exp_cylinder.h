@@ -39,13 +39,13 @@ typedef struct exp_cylinder_result {
 /// What a poured cylinder is expected to cost, before it runs (for the
 /// calibration's plan): granules from the container's volume at the solid
 /// fraction the pours reach (0.53-0.54), steps from eq. 14's dt_crit of the
-/// lightest scaled granule at the a-priori fraction the engine fills at
-/// (0.165), over the 3 s a pour and settling takes (2.9-3.05 s in the 15
+/// lightest scaled granule at the fraction the engine pours at
+/// (EXP_POUR_STEP_FRACTION), over the 3 s a pour and settling takes (2.9-3.05 s in the 15
 /// records of results/calibration-standard/store, λ 32768, k 50-800 N/m).
 typedef struct exp_cylinder_cost {
     double granules;
     double particle_steps;
-    double memory_mb; ///< peak resident memory
+    double memory_mb; ///< peak resident memory (exp_predicted_peak_memory_mb)
 } exp_cylinder_cost;
 
 exp_cylinder_cost exp_cylinder_predict_cost(const exp_cylinder_def *d);

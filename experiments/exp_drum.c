@@ -10,6 +10,7 @@
 #include "dem_checkpoint.h"
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
+#include "exp_cost.h"
 #include "exp_pour.h"
 
 #define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
@@ -20,18 +21,15 @@
 
 exp_drum_cost exp_drum_predict_cost(const exp_drum_def *d, double max_time)
 {
-    // Peak memory: a fixed part and a part per granule, fitted to the records
-    // of two drums (305 granules: 10.1 MB; 3633: 17.1 MB; one thread).
-    const double poured_fraction = 0.6, fill_time = 1.25, fill_fraction = 0.165, turn_fraction = 0.30;
-    const double base_mb = 9.5, mb_per_granule = 2.1e-3;
+    const double poured_fraction = 0.6, fill_time = 1.25, turn_fraction = 0.30;
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     double r = 0.5 * d->diameter, bed_volume = d->fill * DEM_PI * r * r * d->depth;
     double n = (double)dem_gsd_count_for_volume(&gsd, poured_fraction * bed_volume);
     double dt_crit = exp_lightest_dt_crit(&d->gsd, d->density, d->granule.k_n, d->lambda);
     return (exp_drum_cost){.granules = n,
-                           .fill_particle_steps = n * fill_time / (fill_fraction * dt_crit),
+                           .fill_particle_steps = n * fill_time / (EXP_POUR_STEP_FRACTION * dt_crit),
                            .turn_particle_steps = n * max_time / (turn_fraction * dt_crit),
-                           .memory_mb = base_mb + mb_per_granule * n};
+                           .memory_mb = exp_predicted_peak_memory_mb(n)};
 }
 
 exp_drum_def exp_default_drum_def(void)

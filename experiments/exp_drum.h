@@ -94,15 +94,15 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
 /// What a drum run is expected to cost, before it runs (for refusing a tier
 /// that cannot fit the machine or the budget): granules from the bed volume at
 /// a poured solid fraction of 0.6; the steps from eq. 14's dt_crit of the
-/// lightest scaled granule at the fractions the engine runs (0.165 filling:
-/// the a-priori FCC bound; 0.30 turning: a settled bed's network, measured
+/// lightest scaled granule at the fractions the engine runs
+/// (EXP_POUR_STEP_FRACTION filling; 0.30 turning: a settled bed's network, measured
 /// 0.29-0.30 at λ 4096 and 1000, results/benchmarks/drum_end_to_end.md); the
 /// fill charged 1.25 s of simulated time (measured 1.20-1.25 s there).
 typedef struct exp_drum_cost {
     double granules;
     double fill_particle_steps;     ///< pouring and settling one bed
     double turn_particle_steps;     ///< one speed turned for max_time
-    double memory_mb;               ///< one simulation's peak resident memory
+    double memory_mb;               ///< one simulation's peak resident memory (exp_predicted_peak_memory_mb)
 } exp_drum_cost;
 
 /// The expected cost of settling d's bed and turning it for max_time s.
