@@ -75,6 +75,7 @@ dem_diagnostics dem_world_diagnose(const dem_world *w)
     for (size_t i = 0; i < w->n; ++i) {
         d.ke_translational += 0.5 * w->mass[i] * dem_v3_norm2(w->vel[i]);
         d.ke_rotational += 0.5 * w->inertia[i] * dem_v3_norm2(w->omg[i]);
+        d.mass += w->mass[i];
     }
     pair_diagnostics(w, &d);
     wall_diagnostics(w, &d);

@@ -132,6 +132,7 @@ typedef struct dem_diagnostics {
     double coordination_walls; ///< mean (granule + wall) contacts per granule
     double ke_translational;   ///< J
     double ke_rotational;      ///< J
+    double mass;               ///< kg, every granule's (fixed ones too), summed in index order
     double max_overlap_ratio;  ///< max h/R_min over contacts
     double potential_elastic;  ///< J, stored in normal, tangential and rolling springs
 } dem_diagnostics;

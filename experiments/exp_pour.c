@@ -171,11 +171,8 @@ void exp_remove_above(dem_world *w, double y) { dem_world_remove_granules(w, kee
 
 double exp_ke_ratio(const dem_world *w, double d50)
 {
-    dem_granules_view g = dem_world_granules(w);
-    double mass = 0;
-    for (size_t i = 0; i < g.count; ++i) mass += g.mass[i];
     dem_diagnostics d = dem_world_diagnose(w);
-    return g.count ? (d.ke_translational + d.ke_rotational) / (mass * 9.81 * d50) : 0.0;
+    return d.granules ? (d.ke_translational + d.ke_rotational) / (d.mass * 9.81 * d50) : 0.0;
 }
 
 int exp_run_for(dem_world *w, double seconds, exp_progress_fn progress, void *ctx, const char *phase)

@@ -34,13 +34,7 @@ static dem_wall_def plane(dem_vec3 point, dem_vec3 normal, dem_contact_params c,
                           .contact = c, .name = name};
 }
 
-static double total_mass(const dem_world *w)
-{
-    dem_granules_view g = dem_world_granules(w);
-    double m = 0;
-    for (size_t i = 0; i < g.count; ++i) m += g.mass[i];
-    return m;
-}
+static double total_mass(const dem_world *w) { return dem_world_diagnose(w).mass; }
 
 static double kinetic(const dem_world *w)
 {

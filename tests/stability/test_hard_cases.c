@@ -148,13 +148,7 @@ static void check_inside(const dem_world *w, const container *c, const char *lab
     }
 }
 
-static double bed_mass(const dem_world *w)
-{
-    dem_granules_view g = dem_world_granules(w);
-    double m = 0;
-    for (size_t i = 0; i < g.count; ++i) m += g.mass[i];
-    return m;
-}
+static double bed_mass(const dem_world *w) { return dem_world_diagnose(w).mass; }
 
 // Kinetic + elastic (normal, tangential and rolling springs, granule and
 // wall contacts) + gravitational potential above the floor y = 0.
