@@ -71,12 +71,17 @@ static int write_table_csv(const char *dir, const row *rows, int n, char *err, s
     return cal_atomic_commit(&a, err, len);
 }
 
-static const char *range_cell(char out[96], cal_range g)
+// The range, and a warning when the chosen value lies outside it: the choice
+// is the search's best run of the deciding tier, while the range also holds the
+// map tier's corrected candidates (report.md lists each with its origin).
+static const char *range_cell(char out[160], cal_range g, double value)
 {
     if (isfinite(g.lo) && isfinite(g.bracket_lo))
-        snprintf(out, 96, "%.3g – %.3g (not excluded: %.3g – %.3g)", g.lo, g.hi, g.bracket_lo, g.bracket_hi);
-    else if (isfinite(g.lo)) snprintf(out, 96, "%.3g – %.3g", g.lo, g.hi);
+        snprintf(out, 160, "%.3g – %.3g (not excluded: %.3g – %.3g)", g.lo, g.hi, g.bracket_lo, g.bracket_hi);
+    else if (isfinite(g.lo)) snprintf(out, 160, "%.3g – %.3g", g.lo, g.hi);
     else out[0] = '\0';
+    if (isfinite(g.lo) && (value < g.lo || value > g.hi))
+        strncat(out, "; the value lies outside it (report.md)", 160 - strlen(out) - 1);
     return out;
 }
 
@@ -87,22 +92,22 @@ static int write_table_md(const char *dir, const cal_table *t, char *err, size_t
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
-    char g[2][96];
+    char g[2][160];
     fputs("| Contact | Parameter | Material | Value | Identified range (95 %) | Source |\n|---|---|---|---|---|---|\n", f);
     fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | | config |\n", t->density);
     fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | | %s |\n", t->k_n, t->k_source);
     fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
-    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s | %s |\n", t->gg_mu_s, range_cell(g[0], t->gg_mu_s_range), t->gg_source);
-    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s | %s |\n", t->gg_mu_r, range_cell(g[1], t->gg_mu_r_range), t->gg_source);
+    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s | %s |\n", t->gg_mu_s, range_cell(g[0], t->gg_mu_s_range, t->gg_mu_s), t->gg_source);
+    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s | %s |\n", t->gg_mu_r, range_cell(g[1], t->gg_mu_r_range, t->gg_mu_r), t->gg_source);
     fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | | 2 k_n, springs in series (Table 3) |\n",
             exp_boundary_stiffness(t->k_n));
     fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
     for (int w = 0; w < t->n_walls; ++w)
         fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_s[w],
-                range_cell(g[0], t->wall_mu_s_range[w]), t->wall_source[w]);
+                range_cell(g[0], t->wall_mu_s_range[w], t->wall_mu_s[w]), t->wall_source[w]);
     for (int w = 0; w < t->n_walls; ++w)
         fprintf(f, "| | Rolling friction μr,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_r[w],
-                range_cell(g[1], t->wall_mu_r_range[w]), t->wall_source[w]);
+                range_cell(g[1], t->wall_mu_r_range[w], t->wall_mu_r[w]), t->wall_source[w]);
     return cal_atomic_commit(&a, err, len);
 }
 

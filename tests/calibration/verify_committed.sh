@@ -46,6 +46,7 @@ else
   echo "FAIL: the re-derived table differs:"; diff "$results/calibrated_parameters.csv" "$work/out/calibrated_parameters.csv" || true
   fails=$((fails + 1))
 fi
+python3 "$src/tests/calibration/check_value_in_range.py" "$work/out" || fails=$((fails + 1))
 
 # The drum records this command's stages used (simulations.csv: stage, candidate, record, experiment,
 # ...; a two-tier stage lists its map tier's runs as "NAME (map)").
