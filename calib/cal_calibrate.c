@@ -63,6 +63,8 @@ static const char help[] =
     "                     0: none)\n"
     "  --budget-hours H   refuse, before the first simulation, a plan predicted to take\n"
     "                     longer than H hours of wall time\n"
+    "  --plan             check every input, print the plan (simulations, core-hours,\n"
+    "                     wall hours on --jobs workers, memory) and stop: nothing runs\n"
     "  -h, --help         this text\n"
     "\n"
     "Progress: one line per simulation on stderr, ending with the step of the whole\n"
@@ -87,6 +89,7 @@ typedef struct options {
     int jobs;
     double checkpoint_every_s;
     double budget_hours; ///< refuse a plan predicted to take longer (NAN: no limit)
+    int plan_only;       ///< --plan: stop after printing the plan
 } options;
 
 static int parse_options(int argc, char **argv, options *o)
@@ -94,7 +97,7 @@ static int parse_options(int argc, char **argv, options *o)
     static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
                                           {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
                                           {"checkpoint-every", 1, 0, 'c'}, {"data", 1, 0, 'd'},
-                                          {"budget-hours", 1, 0, 'b'},
+                                          {"budget-hours", 1, 0, 'b'}, {"plan", 0, 0, 'p'},
                                           {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S,
                    .budget_hours = NAN};
@@ -110,6 +113,7 @@ static int parse_options(int argc, char **argv, options *o)
         case 'm': o->material = optarg, o->stage = "wall"; break;
         case 'o': o->out = optarg; break;
         case 'd': o->data = optarg; break;
+        case 'p': o->plan_only = 1; break;
         case 'b':
             if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
                 return fprintf(stderr, "granucal calibrate: --budget-hours '%s': expected a number of hours > 0\n", optarg), 2;
@@ -249,6 +253,7 @@ static int prepare(run *r)
     r->env.workers = r->opt.jobs;
     plan_progress(r);
     if (check_predicted_cost(r)) return 1;
+    if (r->opt.plan_only) return 0; // the results folder is not made
     if (r->opt.out) snprintf(r->out, sizeof r->out, "%s", r->opt.out);
     else {
         char stem[1024];
@@ -500,7 +505,8 @@ int cal_cmd_calibrate(int argc, char **argv)
     omp_set_num_threads(1);
 #endif
     status = prepare(r);
-    if (!status) {
+    if (!status && r->opt.plan_only) fputs("granucal calibrate: --plan: every input checked, nothing was run\n", stderr);
+    else if (!status) {
         snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
         r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2); // workers: set by prepare, for the plan
         r->env.checkpoint_every_s = r->opt.checkpoint_every_s;

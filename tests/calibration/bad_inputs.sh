@@ -77,6 +77,16 @@ cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,M
 cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': need NAME=MU_S,MU_R" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
 cmd=synthesize expect "twin: a wall not in the config" "--wall granite: not a material" -- "$work/configs/good.yaml" "${walls[@]}" --wall granite=0.5,0.1 "${out[@]}"
 cmd=synthesize expect "twin: on the candidates' own bed" "--seeds: 2 is a bed of" -- "$work/configs/good.yaml" "${walls[@]}" --tier ci --seeds 2,101 "${out[@]}"
+# --plan checks every input as a run would (a bad one still fails), prints the plan, and
+# stops with exit 0 before making the results folder.
+expect "negative friction under --plan" "pour_mu_s.yaml:" -- "$work/configs/pour_mu_s.yaml" --plan "${out[@]}"
+plan=$(timeout 20 "$bin" calibrate "$work/configs/good.yaml" --tier ci --jobs 2 --plan "${out[@]}" 2>&1 >/dev/null); code=$?
+if [ $code -eq 0 ] && grep -q "^== plan: at most [0-9]* drum runs and [0-9]* poured cylinders, predicted .* on 2 worker" <<< "$plan" &&
+   grep -qF -- "--plan: every input checked, nothing was run" <<< "$plan"; then
+  echo "ok   --plan: $(head -1 <<< "$plan")"
+else
+  echo "FAIL --plan: exit $code: $plan"; fails=$((fails + 1))
+fi
 [ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }
 echo "$fails failure(s)"
 exit $((fails > 0))
