@@ -13,13 +13,14 @@ for s in "spray-dried powder" Aluminium PP PTFE; do
 done
 sed 's|\.\./experiments/data/|../data/|' "$src/configs/calibration.yaml" > "$work/configs/good.yaml"
 fails=0
-# expect NAME EXPECTED-TEXT -- ARGS...: non-zero exit, the text in stderr, under 20 s
-# (the command: calibrate, or $cmd when set for the call).
+# expect NAME EXPECTED-TEXT -- ARGS...: non-zero exit, the text in stderr, under 20 s, and
+# (in the sanitized build) nothing leaked on the way out (the command: calibrate, or $cmd
+# when set for the call).
 expect() {
   local name=$1 want=$2; shift 3
   local start=$SECONDS out
   out=$(timeout 20 "$bin" "${cmd:-calibrate}" "$@" 2>&1 >/dev/null); local code=$?
-  if [ $code -eq 0 ] || [ $code -eq 124 ] || ! grep -qF -- "$want" <<< "$out"; then
+  if [ $code -eq 0 ] || [ $code -eq 124 ] || ! grep -qF -- "$want" <<< "$out" || grep -q LeakSanitizer <<< "$out"; then
     echo "FAIL $name: exit $code, wanted '$want' in: $out"; fails=$((fails + 1))
   else
     echo "ok   $name ($((SECONDS - start)) s): $(head -1 <<< "$out")"
