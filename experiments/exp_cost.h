@@ -9,7 +9,9 @@
 #include "dem_gsd.h"
 
 /// The fraction of eq. 14's dt_crit the engine steps at while a bed is poured:
-/// the a-priori bound of the densest (FCC) cluster, dem_stability_apriori.
+/// the a-priori bound of the densest (FCC) cluster (dem_stability_apriori) for
+/// Table 3's contact, ξ = 0.7; other dashpots move it a little, and a
+/// prediction takes this one number.
 #define EXP_POUR_STEP_FRACTION 0.165
 
 /// Eq. 14's critical step, sqrt(m/k_n), of the lightest granule of a real GSD
