@@ -12,7 +12,9 @@
 #     the script says how many records that left to draw from.
 #   usage: [MAX_RERUN_S=S] [SEED=N] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
-# files, and, for a run made with --data, the data files it read.
+# files, and the data files the run read (repose_angle.csv, occupied_area.csv): for a run made with
+# --data they replace its --data folder, and for one made on the config's own files they are read
+# instead of those (--data), so a later change of the shipped data does not change its table.
 set -euo pipefail
 bin=$1 src=$2 results=$3 work=$4 n=${5:-2}
 rm -rf "$work" && mkdir -p "$work/out"
@@ -31,6 +33,9 @@ for ((i = 2; i < ${#words[@]}; ++i)); do # words[0..1]: granucal calibrate
   esac
 done
 grep -q -- "--out" <<< "${args[*]}" || args+=(--out "$work/out")
+if ! grep -q -- "--data" <<< "${args[*]}" && [ -f "$results/repose_angle.csv" ] && [ -f "$results/occupied_area.csv" ]; then
+  args+=(--data "$results")
+fi
 cp -r "$results/store" "$work/out/"
 cp "$results"/stage_*.yaml "$work/out/" 2>/dev/null || true
 run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs 1 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
