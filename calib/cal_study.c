@@ -43,6 +43,9 @@ static const char help[] =
     "\n"
     "options:\n"
     "  --out DIR            results folder (default results/fidelity)\n"
+    "  --report DIR         write fidelity.md, its CSVs and plots into DIR instead of\n"
+    "                       OUT (the runs still go to OUT/store): a few rungs or speeds\n"
+    "                       reported beside the ladder's own fidelity.md, not over it\n"
     "  --budget-hours H     replaces fidelity.budget_hours\n"
     "  --seeds N            replaces fidelity.seeds (1-16)\n"
     "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
@@ -66,6 +69,7 @@ static const struct {
 
 typedef struct options {
     const char *config, *out, *rungs, *rpm; ///< rungs, rpm: comma lists (NULL: all)
+    const char *report;                     ///< where the report goes (NULL: out)
     double budget_hours, checkpoint_every_s;
     int jobs, seeds; ///< seeds 0: the config's
 } options;
@@ -88,7 +92,7 @@ typedef struct study {
     options opt;
     cal_config *c;
     cal_env env;
-    char out[1024];
+    char out[1024], report[1024];
     rung_result res[MAX_RUNGS];
     int n;
     int finest;                  ///< index of the finest rung run (converged only if shown: write_convergence)
@@ -101,7 +105,7 @@ static int parse_options(int argc, char **argv, options *o)
                                           {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
                                           {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
                                           {"checkpoint-every", required_argument, 0, 'c'}, {"rpm", required_argument, 0, 'm'},
-                                          {0, 0, 0, 0}};
+                                          {"report", required_argument, 0, 'p'}, {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     optind = 1;
@@ -109,6 +113,7 @@ static int parse_options(int argc, char **argv, options *o)
         double v = NAN;
         switch (ch) {
         case 'o': o->out = optarg; break;
+        case 'p': o->report = optarg; break;
         case 'r': o->rungs = optarg; break;
         case 'm': o->rpm = optarg; break;
         case 'b':
@@ -306,7 +311,7 @@ static int write_csv(const study *s, char *err, size_t len)
     const cal_fidelity *f = s->c->fidelity;
     char path[1200];
     cal_atomic_file a;
-    snprintf(path, sizeof path, "%s/fidelity.csv", s->out);
+    snprintf(path, sizeof path, "%s/fidelity.csv", s->report);
     if (cal_atomic_open(&a, path, err, len)) return 1;
     fputs("rung,lambda,slice_depth_m,max_time_s,window_s,seeds,rpm,angle_deg,angle_sd_seeds_deg,angle_se_deg,csa_percent,"
           "csa_sd_seeds_percent,steady_runs,usable_runs\n",
@@ -320,7 +325,7 @@ static int write_csv(const study *s, char *err, size_t len)
                     r->angle_sd[k], r->angle_se[k], r->csa[k], r->csa_sd[k], r->steady[k], r->usable[k]);
     }
     if (cal_atomic_commit(&a, err, len)) return 1;
-    snprintf(path, sizeof path, "%s/fidelity_summary.csv", s->out);
+    snprintf(path, sizeof path, "%s/fidelity_summary.csv", s->report);
     if (cal_atomic_open(&a, path, err, len)) return 1;
     fputs("rung,lambda,slice_depth_m,max_time_s,window_s,status,granules,particle_steps,wall_time_s,wall_time_per_run_s,"
           "predicted_wall_time_s,peak_rss_mb,dt_s,angle_error_deg,csa_rms_error_percent,finest_rung\n",
@@ -418,7 +423,7 @@ static int write_markdown(const study *s, const char *command, double wall, char
     const cal_fidelity *f = s->c->fidelity;
     char path[1200];
     cal_atomic_file a;
-    snprintf(path, sizeof path, "%s/fidelity.md", s->out);
+    snprintf(path, sizeof path, "%s/fidelity.md", s->report);
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *o = a.f;
     fprintf(o, "# What accuracy costs in time: the drum fidelity ladder\n\nCommand: `%s`  \ngranucal %s (commit %s), "
@@ -504,7 +509,7 @@ static void collect_rungs(const study *s, rung_points *p)
 static int plot_error_vs_cost(const study *s, const rung_points *p, char *err, size_t len)
 {
     char path[1200], title[160];
-    snprintf(path, sizeof path, "%s/fidelity_error_vs_cost.png", s->out);
+    snprintf(path, sizeof path, "%s/fidelity_error_vs_cost.png", s->report);
     snprintf(title, sizeof title, "What accuracy costs: error against the finest rung (%s)",
              s->finest >= 0 ? s->res[s->finest].rung->name : "none");
     exp_plot_series v[2] = {
@@ -537,7 +542,7 @@ static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_
          .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_DIAMOND, .dashed = 1},
     };
     char path[1200], title[160];
-    snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->out);
+    snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->report);
     snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", s->c->fidelity->rpm[0]);
     exp_plot_axes axes = {.title = title, .xlabel = "scale factor λ", .ylabel = "angle (°) / CSA (%)", .log_x = 1};
     return exp_plot_png(path, &axes, 4, v, 1000, 640, err, len);
@@ -608,7 +613,8 @@ int cal_cmd_study(int argc, char **argv)
     if (!status && s->opt.rpm) status = narrow_speeds(s->c->fidelity, s->opt.rpm, s->c->path, s->err, sizeof s->err);
     if (!status) {
         snprintf(s->out, sizeof s->out, "%s", s->opt.out);
-        status = cal_prepare_output(s->out, s->err, sizeof s->err);
+        snprintf(s->report, sizeof s->report, "%s", s->opt.report ? s->opt.report : s->opt.out);
+        status = cal_prepare_output(s->out, s->err, sizeof s->err) || cal_mkdirs(s->report, s->err, sizeof s->err);
     }
     if (!status) {
         snprintf(s->env.store, sizeof s->env.store, "%s/store", s->out);
@@ -621,7 +627,7 @@ int cal_cmd_study(int argc, char **argv)
         errors_against_finest(s);
         status = write_csv(s, s->err, sizeof s->err) || write_markdown(s, command, exp_wall_seconds() - t0, s->err, sizeof s->err) ||
                  write_plots(s, s->err, sizeof s->err);
-        if (!status) fprintf(stderr, "granucal study: wrote %s/fidelity.md and its CSV and plots\n", s->out);
+        if (!status) fprintf(stderr, "granucal study: wrote %s/fidelity.md and its CSV and plots\n", s->report);
     }
     if (status) fprintf(stderr, "granucal study: %s\n", s->err);
     status = cal_mpi_any(status);

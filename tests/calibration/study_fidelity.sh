@@ -56,4 +56,11 @@ if grep -q "simulated in" "$work/ladder.log"; then echo "the committed ladder wa
 grep -q "but the angle is still moving.*0.93 ± 0.15° (6.2 standard errors" "$work/ladder/fidelity.md" ||
   { echo "the committed ladder's verdict is wrong:"; grep -A1 "finest rung run" "$work/ladder/fidelity.md"; exit 1; }
 grep -q "levelled off" "$work/ladder/fidelity.md" && { echo "the committed ladder is called levelled off"; exit 1; }
-echo "fidelity study: 2 rungs run, 1 predicted, rerun from the store; the committed ladder read as still moving"
+# --report: one rung's report written beside the ladder's, which stays as it was.
+before=$(md5sum < "$work/ladder/fidelity.md")
+"$bin" study fidelity configs/calibration.yaml --out "$work/ladder" --report "$work/ladder/one_rung" --jobs 1 \
+  --budget-hours 100 --rpm 4 --rungs L512-slice8-avg8 > "$work/one_rung.log" 2>&1 || { cat "$work/one_rung.log"; exit 1; }
+[ "$(md5sum < "$work/ladder/fidelity.md")" = "$before" ] || { echo "--report overwrote the ladder's fidelity.md"; exit 1; }
+grep -q "The finest rung run is L512-slice8-avg8" "$work/ladder/one_rung/fidelity.md" || { echo "--report wrote no report"; exit 1; }
+[ -e "$work/ladder/one_rung/store" ] && { echo "--report made a second store"; exit 1; }
+echo "fidelity study: 2 rungs run, 1 predicted, rerun from the store; the committed ladder read as still moving; --report beside it"
