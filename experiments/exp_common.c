@@ -52,12 +52,28 @@ int exp_parse_number(const char *text, double *out)
 
 int exp_integer_in(double v, double lo, double hi) { return v == floor(v) && v >= lo && v <= hi; }
 
-int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len)
+int exp_set_key_value(const exp_set_key *keys, size_t n, const char *key, const char *value, char *err, size_t len)
 {
-    const char *text = NULL;
-    if (exp_split_set(set, key, &text, err, len)) return 1;
-    if (exp_parse_number(text, value)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, text);
-    return 0;
+    for (size_t k = 0; k < n; ++k) {
+        if (strcmp(key, keys[k].name) != 0) continue;
+        double v;
+        if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
+        if (!keys[k].integer) return *keys[k].number = v, 0;
+        if (!exp_integer_in(v, 0, 2147483647.0))
+            return exp_fail(err, len, "--set %s: '%s' is not a non-negative integer", key, value);
+        *keys[k].integer = (int)v;
+        return 0;
+    }
+    return -1;
+}
+
+int exp_set_unknown(const exp_set_key *keys, size_t n, const char *more, const char *key, char *err, size_t len)
+{
+    char known[512] = "";
+    for (size_t k = 0; k < n; ++k)
+        snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", k ? ", " : "", keys[k].name);
+    if (more) snprintf(known + strlen(known), sizeof known - strlen(known), ", %s", more);
+    return exp_fail(err, len, "--set %s: unknown key (known: %s)", key, known);
 }
 
 double exp_peak_rss_mb(void)

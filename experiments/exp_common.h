@@ -36,9 +36,22 @@ int exp_split_set(const char *set, char key[32], const char **value, char *err, 
 int exp_parse_number(const char *text, double *out);
 /// 1 if v is a whole number in [lo, hi] (a seed, a count), else 0.
 int exp_integer_in(double v, double lo, double hi);
-/// exp_split_set for a value that must be a finite number: 0, else 1 with a
-/// message naming the key.
-int exp_parse_set(const char *set, char key[32], double *value, char *err, size_t len);
+
+/// A key a scene's `--set KEY=VALUE` may set: a number, or (integer) a whole
+/// number >= 0 (a seed, a count).
+typedef struct exp_set_key {
+    const char *name;
+    double *number;
+    int *integer;
+} exp_set_key;
+
+/// Sets the key of keys[0..n) named `key` from the text `value`: 0; 1 with a
+/// message naming the key when the value is not a finite number (for an
+/// integer key, not a whole number in [0, 2^31)); -1 when no key has that name.
+int exp_set_key_value(const exp_set_key *keys, size_t n, const char *key, const char *value, char *err, size_t len);
+/// Refuses `key` as unknown, listing the names of keys[0..n) and then `more`
+/// (the scene's other keys, or NULL): always 1.
+int exp_set_unknown(const exp_set_key *keys, size_t n, const char *more, const char *key, char *err, size_t len);
 
 /// Peak resident memory of this process so far, MiB (getrusage).
 double exp_peak_rss_mb(void);

@@ -452,22 +452,18 @@ static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t
 static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
 {
     char key[32];
-    double v;
-    if (exp_parse_set(set, key, &v, err, len)) return 1;
-    struct { const char *name; double *field; } numbers[] = {
-        {"k_n", &y->k_n}, {"mu_s", &y->mu_s}, {"wall_mu_s", &y->wall_mu_s}, {"xi", &y->xi}, {"lambda", &y->lambda},
-        {"sigma_min", &y->sigma_min}, {"sigma_max", &y->sigma_max}, {"piston_speed", &y->piston_speed},
-        {"max_time", &y->max_time}};
-    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
-        if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
-    if (strcmp(key, "seed") == 0 || strcmp(key, "cycles") == 0) {
-        if (!exp_integer_in(v, 0, 2147483647.0)) return exp_fail(err, len, "--set %s: %g is not a non-negative integer", key, v);
-        *(strcmp(key, "seed") == 0 ? &y->seed : &y->cycles) = (int)v;
-        return 0;
-    }
+    const char *value;
+    if (exp_split_set(set, key, &value, err, len)) return 1;
+    const exp_set_key keys[] = {
+        {"k_n", &y->k_n, NULL},     {"mu_s", &y->mu_s, NULL},           {"wall_mu_s", &y->wall_mu_s, NULL},
+        {"xi", &y->xi, NULL},       {"lambda", &y->lambda, NULL},       {"seed", NULL, &y->seed},
+        {"sigma_min", &y->sigma_min, NULL}, {"sigma_max", &y->sigma_max, NULL}, {"piston_speed", &y->piston_speed, NULL},
+        {"cycles", NULL, &y->cycles}, {"max_time", &y->max_time, NULL}};
+    const size_t n = sizeof keys / sizeof *keys;
+    int found = exp_set_key_value(keys, n, key, value, err, len);
+    if (found >= 0) return found;
     if (strcmp(key, "mu_r") == 0) return exp_fail(err, len, "--set mu_r: the compression test has no rolling resistance");
-    return exp_fail(err, len, "--set %s: unknown key (known: k_n, mu_s, wall_mu_s, xi, lambda, seed, sigma_min, "
-                              "sigma_max, piston_speed, cycles, max_time)", key);
+    return exp_set_unknown(keys, n, NULL, key, err, len);
 }
 
 static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)

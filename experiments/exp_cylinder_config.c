@@ -83,24 +83,14 @@ static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t
 static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
 {
     char key[32];
-    double v;
-    if (exp_parse_set(set, key, &v, err, len)) return 1;
-    struct {
-        const char *name;
-        double *field;
-    } numbers[] = {{"k_n", &y->k_n},           {"mu_s", &y->mu_s},         {"mu_r", &y->mu_r},
-                   {"xi", &y->xi},             {"lambda", &y->lambda},     {"diameter", &y->diameter},
-                   {"depth", &y->depth},       {"density", &y->density}};
-    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
-        if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
-    if (strcmp(key, "seed") == 0) {
-        if (!exp_integer_in(v, 0, 2147483647.0))
-            return exp_fail(err, len, "--set seed: %g is not a non-negative integer", v);
-        y->seed = (int)v;
-        return 0;
-    }
-    return exp_fail(err, len,
-                    "--set %s: unknown key (known: k_n, mu_s, mu_r, xi, lambda, seed, diameter, depth, density)", key);
+    const char *value;
+    if (exp_split_set(set, key, &value, err, len)) return 1;
+    const exp_set_key keys[] = {{"k_n", &y->k_n, NULL},       {"mu_s", &y->mu_s, NULL},   {"mu_r", &y->mu_r, NULL},
+                                {"xi", &y->xi, NULL},         {"lambda", &y->lambda, NULL}, {"seed", NULL, &y->seed},
+                                {"diameter", &y->diameter, NULL}, {"depth", &y->depth, NULL}, {"density", &y->density, NULL}};
+    const size_t n = sizeof keys / sizeof *keys;
+    int found = exp_set_key_value(keys, n, key, value, err, len);
+    return found >= 0 ? found : exp_set_unknown(keys, n, NULL, key, err, len);
 }
 
 // The error for `field`: from a --set if one gave it, else located in the file.

@@ -69,16 +69,14 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         *text = copy;
         return 0;
     }
-    struct { const char *name; double *field; } numbers[] = {
-        {"rpm", &y->rpm}, {"mu_s", &y->mu_s}, {"mu_r", &y->mu_r}, {"k_n", &y->k_n}, {"lambda", &y->lambda},
-        {"fill", &y->fill}, {"slice_depth", &y->slice_depth}, {"max_time", &y->max_time}, {"xi", &y->xi}};
+    const exp_set_key keys[] = {{"rpm", &y->rpm, NULL},       {"mu_s", &y->mu_s, NULL},   {"mu_r", &y->mu_r, NULL},
+                                {"k_n", &y->k_n, NULL},       {"xi", &y->xi, NULL},       {"lambda", &y->lambda, NULL},
+                                {"seed", NULL, &y->seed},     {"fill", &y->fill, NULL},   {"slice_depth", &y->slice_depth, NULL},
+                                {"max_time", &y->max_time, NULL}};
+    const size_t n = sizeof keys / sizeof *keys;
+    int found = exp_set_key_value(keys, n, key, value, err, len);
+    if (found >= 0) return found;
     double v;
-    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
-        if (strcmp(key, numbers[k].name) == 0) {
-            if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
-            *numbers[k].field = v;
-            return 0;
-        }
     if (strcmp(key, "start_tilt_deg") == 0) {
         if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
         if (!y->start_tilt_deg && !(y->start_tilt_deg = malloc(sizeof *y->start_tilt_deg)))
@@ -86,14 +84,7 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         *y->start_tilt_deg = v;
         return 0;
     }
-    if (strcmp(key, "seed") == 0) {
-        if (exp_parse_number(value, &v) || !exp_integer_in(v, 0, 2147483647.0))
-            return exp_fail(err, len, "--set seed: '%s' is not a non-negative integer", value);
-        y->seed = (int)v;
-        return 0;
-    }
-    return exp_fail(err, len, "--set %s: unknown key (known: rpm, mu_s, mu_r, k_n, xi, wall, lambda, seed, fill, "
-                          "slice_depth, max_time, start_tilt_deg, fill_method)", key);
+    return exp_set_unknown(keys, n, "wall, start_tilt_deg, fill_method", key, err, len);
 }
 
 static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char *name)

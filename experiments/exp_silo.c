@@ -380,21 +380,19 @@ static void to_def(const silo_yaml *y, exp_silo_def *d)
 static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
 {
     char key[32];
-    double v;
-    if (exp_parse_set(set, key, &v, err, len)) return 1;
-    struct { const char *name; double *field; } numbers[] = {
-        {"k_n", &y->k_n}, {"mu_s", &y->mu_s}, {"duration", &y->duration}, {"orifice_radius", &y->orifice_radius},
-        {"silo_radius", &y->silo_radius}, {"plate_z", &y->plate_z}, {"dt", &y->dt}, {"xi", &y->xi}};
-    for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
-        if (strcmp(key, numbers[k].name) == 0) return *numbers[k].field = v, 0;
-    if (strcmp(key, "seed") == 0 || strcmp(key, "n_granules") == 0) {
-        if (!exp_integer_in(v, 0, 2147483647.0)) return exp_fail(err, len, "--set %s: %g is not a non-negative integer", key, v);
-        *(strcmp(key, "seed") == 0 ? &y->seed : &y->n_granules) = (int)v;
-        return 0;
-    }
+    const char *value;
+    if (exp_split_set(set, key, &value, err, len)) return 1;
+    const exp_set_key keys[] = {
+        {"k_n", &y->k_n, NULL},         {"mu_s", &y->mu_s, NULL},
+        {"xi", &y->xi, NULL},           {"dt", &y->dt, NULL},
+        {"duration", &y->duration, NULL}, {"orifice_radius", &y->orifice_radius, NULL},
+        {"silo_radius", &y->silo_radius, NULL}, {"plate_z", &y->plate_z, NULL},
+        {"n_granules", NULL, &y->n_granules}, {"seed", NULL, &y->seed}};
+    const size_t n = sizeof keys / sizeof *keys;
+    int found = exp_set_key_value(keys, n, key, value, err, len);
+    if (found >= 0) return found;
     if (strcmp(key, "mu_r") == 0) return exp_fail(err, len, "--set mu_r: the silo benchmark has no rolling resistance");
-    return exp_fail(err, len, "--set %s: unknown key (known: k_n, mu_s, xi, dt, duration, orifice_radius, silo_radius, "
-                              "plate_z, n_granules, seed)", key);
+    return exp_set_unknown(keys, n, NULL, key, err, len);
 }
 
 static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len)
