@@ -56,6 +56,7 @@ int exp_set_key_value(const exp_set_key *keys, size_t n, const char *key, const 
 {
     for (size_t k = 0; k < n; ++k) {
         if (strcmp(key, keys[k].name) != 0) continue;
+        if (keys[k].refused) return exp_fail(err, len, "--set %s: %s", key, keys[k].refused);
         double v;
         if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
         if (!keys[k].integer) return *keys[k].number = v, 0;
@@ -71,9 +72,19 @@ int exp_set_unknown(const exp_set_key *keys, size_t n, const char *more, const c
 {
     char known[512] = "";
     for (size_t k = 0; k < n; ++k)
-        snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", k ? ", " : "", keys[k].name);
+        if (!keys[k].refused)
+            snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", *known ? ", " : "", keys[k].name);
     if (more) snprintf(known + strlen(known), sizeof known - strlen(known), ", %s", more);
     return exp_fail(err, len, "--set %s: unknown key (known: %s)", key, known);
+}
+
+int exp_apply_set(const char *set, const exp_set_key *keys, size_t n, char *err, size_t len)
+{
+    char key[32];
+    const char *value = NULL;
+    if (exp_split_set(set, key, &value, err, len)) return 1;
+    int found = exp_set_key_value(keys, n, key, value, err, len);
+    return found >= 0 ? found : exp_set_unknown(keys, n, NULL, key, err, len);
 }
 
 double exp_peak_rss_mb(void)

@@ -38,20 +38,30 @@ int exp_parse_number(const char *text, double *out);
 int exp_integer_in(double v, double lo, double hi);
 
 /// A key a scene's `--set KEY=VALUE` may set: a number, or (integer) a whole
-/// number >= 0 (a seed, a count).
+/// number >= 0 (a seed, a count); or, with `refused`, a key the scene names
+/// only to say why it has none (the silo's mu_r).
 typedef struct exp_set_key {
     const char *name;
     double *number;
     int *integer;
+    const char *refused;
 } exp_set_key;
+
+#define EXP_SET_NUMBER(key, field) {.name = (key), .number = (field)}
+#define EXP_SET_INTEGER(key, field) {.name = (key), .integer = (field)}
+#define EXP_SET_REFUSED(key, why) {.name = (key), .refused = (why)}
 
 /// Sets the key of keys[0..n) named `key` from the text `value`: 0; 1 with a
 /// message naming the key when the value is not a finite number (for an
-/// integer key, not a whole number in [0, 2^31)); -1 when no key has that name.
+/// integer key, not a whole number in [0, 2^31)) or the key is refused; -1
+/// when no key has that name.
 int exp_set_key_value(const exp_set_key *keys, size_t n, const char *key, const char *value, char *err, size_t len);
-/// Refuses `key` as unknown, listing the names of keys[0..n) and then `more`
-/// (the scene's other keys, or NULL): always 1.
+/// Refuses `key` as unknown, listing the names of keys[0..n) (not the refused
+/// ones) and then `more` (the scene's other keys, or NULL): always 1.
 int exp_set_unknown(const exp_set_key *keys, size_t n, const char *more, const char *key, char *err, size_t len);
+/// A whole `--set KEY=VALUE` for a scene whose keys are all in keys[0..n):
+/// 0, else 1 with a message.
+int exp_apply_set(const char *set, const exp_set_key *keys, size_t n, char *err, size_t len);
 
 /// Peak resident memory of this process so far, MiB (getrusage).
 double exp_peak_rss_mb(void);

@@ -451,19 +451,14 @@ static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t
 
 static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
 {
-    char key[32];
-    const char *value;
-    if (exp_split_set(set, key, &value, err, len)) return 1;
     const exp_set_key keys[] = {
-        {"k_n", &y->k_n, NULL},     {"mu_s", &y->mu_s, NULL},           {"wall_mu_s", &y->wall_mu_s, NULL},
-        {"xi", &y->xi, NULL},       {"lambda", &y->lambda, NULL},       {"seed", NULL, &y->seed},
-        {"sigma_min", &y->sigma_min, NULL}, {"sigma_max", &y->sigma_max, NULL}, {"piston_speed", &y->piston_speed, NULL},
-        {"cycles", NULL, &y->cycles}, {"max_time", &y->max_time, NULL}};
-    const size_t n = sizeof keys / sizeof *keys;
-    int found = exp_set_key_value(keys, n, key, value, err, len);
-    if (found >= 0) return found;
-    if (strcmp(key, "mu_r") == 0) return exp_fail(err, len, "--set mu_r: the compression test has no rolling resistance");
-    return exp_set_unknown(keys, n, NULL, key, err, len);
+        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("wall_mu_s", &y->wall_mu_s),
+        EXP_SET_NUMBER("xi", &y->xi), EXP_SET_NUMBER("lambda", &y->lambda), EXP_SET_INTEGER("seed", &y->seed),
+        EXP_SET_NUMBER("sigma_min", &y->sigma_min), EXP_SET_NUMBER("sigma_max", &y->sigma_max),
+        EXP_SET_NUMBER("piston_speed", &y->piston_speed), EXP_SET_INTEGER("cycles", &y->cycles),
+        EXP_SET_NUMBER("max_time", &y->max_time),
+        EXP_SET_REFUSED("mu_r", "the compression test has no rolling resistance")};
+    return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
 }
 
 static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)

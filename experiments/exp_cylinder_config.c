@@ -82,15 +82,12 @@ static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t
 
 static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
 {
-    char key[32];
-    const char *value;
-    if (exp_split_set(set, key, &value, err, len)) return 1;
-    const exp_set_key keys[] = {{"k_n", &y->k_n, NULL},       {"mu_s", &y->mu_s, NULL},   {"mu_r", &y->mu_r, NULL},
-                                {"xi", &y->xi, NULL},         {"lambda", &y->lambda, NULL}, {"seed", NULL, &y->seed},
-                                {"diameter", &y->diameter, NULL}, {"depth", &y->depth, NULL}, {"density", &y->density, NULL}};
-    const size_t n = sizeof keys / sizeof *keys;
-    int found = exp_set_key_value(keys, n, key, value, err, len);
-    return found >= 0 ? found : exp_set_unknown(keys, n, NULL, key, err, len);
+    const exp_set_key keys[] = {
+        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("mu_r", &y->mu_r),
+        EXP_SET_NUMBER("xi", &y->xi), EXP_SET_NUMBER("lambda", &y->lambda), EXP_SET_INTEGER("seed", &y->seed),
+        EXP_SET_NUMBER("diameter", &y->diameter), EXP_SET_NUMBER("depth", &y->depth),
+        EXP_SET_NUMBER("density", &y->density)};
+    return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
 }
 
 // The error for `field`: from a --set if one gave it, else located in the file.

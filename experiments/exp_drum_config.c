@@ -69,10 +69,11 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         *text = copy;
         return 0;
     }
-    const exp_set_key keys[] = {{"rpm", &y->rpm, NULL},       {"mu_s", &y->mu_s, NULL},   {"mu_r", &y->mu_r, NULL},
-                                {"k_n", &y->k_n, NULL},       {"xi", &y->xi, NULL},       {"lambda", &y->lambda, NULL},
-                                {"seed", NULL, &y->seed},     {"fill", &y->fill, NULL},   {"slice_depth", &y->slice_depth, NULL},
-                                {"max_time", &y->max_time, NULL}};
+    const exp_set_key keys[] = {
+        EXP_SET_NUMBER("rpm", &y->rpm), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("mu_r", &y->mu_r),
+        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("xi", &y->xi), EXP_SET_NUMBER("lambda", &y->lambda),
+        EXP_SET_INTEGER("seed", &y->seed), EXP_SET_NUMBER("fill", &y->fill),
+        EXP_SET_NUMBER("slice_depth", &y->slice_depth), EXP_SET_NUMBER("max_time", &y->max_time)};
     const size_t n = sizeof keys / sizeof *keys;
     int found = exp_set_key_value(keys, n, key, value, err, len);
     if (found >= 0) return found;

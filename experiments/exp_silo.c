@@ -379,20 +379,13 @@ static void to_def(const silo_yaml *y, exp_silo_def *d)
 
 static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
 {
-    char key[32];
-    const char *value;
-    if (exp_split_set(set, key, &value, err, len)) return 1;
     const exp_set_key keys[] = {
-        {"k_n", &y->k_n, NULL},         {"mu_s", &y->mu_s, NULL},
-        {"xi", &y->xi, NULL},           {"dt", &y->dt, NULL},
-        {"duration", &y->duration, NULL}, {"orifice_radius", &y->orifice_radius, NULL},
-        {"silo_radius", &y->silo_radius, NULL}, {"plate_z", &y->plate_z, NULL},
-        {"n_granules", NULL, &y->n_granules}, {"seed", NULL, &y->seed}};
-    const size_t n = sizeof keys / sizeof *keys;
-    int found = exp_set_key_value(keys, n, key, value, err, len);
-    if (found >= 0) return found;
-    if (strcmp(key, "mu_r") == 0) return exp_fail(err, len, "--set mu_r: the silo benchmark has no rolling resistance");
-    return exp_set_unknown(keys, n, NULL, key, err, len);
+        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("xi", &y->xi),
+        EXP_SET_NUMBER("dt", &y->dt), EXP_SET_NUMBER("duration", &y->duration),
+        EXP_SET_NUMBER("orifice_radius", &y->orifice_radius), EXP_SET_NUMBER("silo_radius", &y->silo_radius),
+        EXP_SET_NUMBER("plate_z", &y->plate_z), EXP_SET_INTEGER("n_granules", &y->n_granules),
+        EXP_SET_INTEGER("seed", &y->seed), EXP_SET_REFUSED("mu_r", "the silo benchmark has no rolling resistance")};
+    return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
 }
 
 static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len)
