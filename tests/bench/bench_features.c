@@ -10,6 +10,7 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include "bench_bed.h"
 #include "dem_gsd.h"
 #include "dem_world.h"
 
@@ -25,40 +26,12 @@ typedef struct variant {
     double mu_s, mu_r, xi;
 } variant;
 
-// A bed poured into a periodic slab (periodic along z) on a floor, settled.
+// The benchmark bed (bench_bed.h): 1 mm granules in a 4 x 2 cm slab, settled 0.3 s.
 static dem_world *settled_bed(int n, double dt)
 {
     dem_world_def def = dem_default_world_def();
-    const double width = 0.04, depth = 0.02;
-    def.domain_lo = dem_v3(-width, -0.01, 0);
-    def.domain_hi = dem_v3(width, 0.5, depth);
-    def.periodic_axis = 2;
     def.dt = dt;
-    dem_world *w = dem_world_create(&def, NULL, 0);
-    dem_contact_params wall = def.granule;
-    wall.k_n = wall.k_s = wall.k_r = 400;
-    dem_wall_def planes[3] = {{.kind = DEM_WALL_PLANE, .point = {0, 0, 0}, .normal = {0, 1, 0}, .contact = wall},
-                              {.kind = DEM_WALL_PLANE, .point = {-width / 2, 0, 0}, .normal = {1, 0, 0}, .contact = wall},
-                              {.kind = DEM_WALL_PLANE, .point = {width / 2, 0, 0}, .normal = {-1, 0, 0}, .contact = wall}};
-    for (int k = 0; k < 3; ++k) dem_world_add_wall(w, &planes[k]);
-    dem_gsd g = dem_default_gsd();
-    g.median_diameter = 1e-3;
-    double *d = malloc((size_t)n * sizeof *d);
-    dem_gsd_sample(&g, 1, (size_t)n, d);
-    double pitch = dem_gsd_max_diameter(&g) * 1.05;
-    int nx = (int)(width / pitch) - 1, nz = (int)(depth / pitch);
-    for (int i = 0; i < n; ++i) {
-        int ix = i % nx, iz = (i / nx) % nz, iy = i / (nx * nz);
-        dem_world_add_granule(w, dem_v3(-width / 2 + pitch * (ix + 1), pitch * (iy + 1), pitch * (iz + 0.5)),
-                              dem_v3(0.01 * sin(i), 0, 0), dem_v3(0, 0, 0), 0.5 * d[i], 1800);
-    }
-    free(d);
-    if (dem_world_prepare(w) != DEM_OK) {
-        fprintf(stderr, "%s\n", dem_world_error(w));
-        exit(1);
-    }
-    dem_world_step(w, (uint64_t)(0.3 / dem_world_dt(w)));
-    return w;
+    return bench_settled_bed(def, n, 0.04, 0.02, 0.5, 1e-3, 0.3);
 }
 
 int main(int argc, char **argv)
