@@ -33,6 +33,15 @@ double exp_wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+void exp_print_progress(const char *phase, double t, size_t granules, void *printer)
+{
+    exp_progress_printer *p = printer;
+    double now = exp_wall_seconds();
+    if (now - p->last < 10.0) return;
+    p->last = now;
+    fprintf(stderr, "%s: %s t = %.4f s, %zu granules, wall %.0f s\n", p->scene, phase, t, granules, now - p->start);
+}
+
 int exp_split_set(const char *set, char key[32], const char **value, char *err, size_t len)
 {
     const char *eq = strchr(set, '=');

@@ -22,6 +22,15 @@ const char *exp_results_version(void);
 /// Progress callback of long phases: phase name, simulated time, granules.
 typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);
 
+/// A scene's progress printer (an exp_progress_fn's ctx): one line on stderr
+/// at most every 10 s of wall time, "<scene>: <phase> t = ... s, N granules,
+/// wall W s". Start it with {scene, 0, exp_wall_seconds()}.
+typedef struct exp_progress_printer {
+    const char *scene;
+    double last, start;
+} exp_progress_printer;
+void exp_print_progress(const char *phase, double t, size_t granules, void *printer);
+
 /// Format a message into err (printf-style) and return 1: the error path of
 /// every loader and builder here.
 int exp_fail(char *err, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));

@@ -491,19 +491,6 @@ int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_de
     return 0;
 }
 
-typedef struct progress_state {
-    double last, start;
-} progress_state;
-
-static void show_progress(const char *phase, double t, size_t granules, void *ctx)
-{
-    progress_state *p = ctx;
-    double now = exp_wall_seconds();
-    if (now - p->last < 10.0) return;
-    p->last = now;
-    fprintf(stderr, "compression: %s t = %.4f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
-}
-
 static void write_json(FILE *f, const compress_yaml *y, const exp_compress_def *d, const exp_compress_result *r,
                        const dem_world *w, const char *status, double wall)
 {
@@ -572,9 +559,9 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
         exp_yaml_free(&compress_schema, y);
         return 1;
     }
-    progress_state p = {0, exp_wall_seconds()};
+    exp_progress_printer p = {"compression", 0, exp_wall_seconds()};
     exp_compress_result r;
-    dem_world *w = exp_compress_run(&d, show_progress, &p, &r, err, sizeof err);
+    dem_world *w = exp_compress_run(&d, exp_print_progress, &p, &r, err, sizeof err);
     int rc = 1;
     if (!w) {
         fprintf(stderr, "granucal simulate: %s\n", err);

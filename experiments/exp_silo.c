@@ -425,19 +425,6 @@ static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_sil
     return y;
 }
 
-typedef struct progress_state {
-    double last, start;
-} progress_state;
-
-static void show_progress(const char *phase, double t, size_t granules, void *ctx)
-{
-    progress_state *p = ctx;
-    double now = exp_wall_seconds();
-    if (now - p->last < 10.0) return;
-    p->last = now;
-    fprintf(stderr, "silo: %s t = %.2f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
-}
-
 static void write_json(FILE *f, const exp_silo_def *d, const exp_silo_result *r, const dem_world *w, const char *status)
 {
     char effects[1024];
@@ -471,9 +458,9 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     exp_yaml_free(&silo_schema, y);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/silo");
     if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    progress_state ps = {0, exp_wall_seconds()};
+    exp_progress_printer ps = {"silo", 0, exp_wall_seconds()};
     size_t plate = 0;
-    dem_world *w = exp_silo_prepare(&d, show_progress, &ps, &plate, err, sizeof err);
+    dem_world *w = exp_silo_prepare(&d, exp_print_progress, &ps, &plate, err, sizeof err);
     if (!w) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     double fill_wall = exp_wall_seconds() - ps.start;
     if (dem_world_prepare(w) != DEM_OK) {
@@ -487,7 +474,7 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
             dem_world_granules(w).count - plate, plate, fill_wall, dem_world_dt_report(w));
     exp_silo_result r;
     double t0 = exp_wall_seconds();
-    dem_status st = exp_silo_discharge(w, &d, plate, show_progress, &ps, &r);
+    dem_status st = exp_silo_discharge(w, &d, plate, exp_print_progress, &ps, &r);
     r.wall_time_s = exp_wall_seconds() - t0;
     r.fill_time_s = fill_wall;
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: silo: %s\n", dem_world_error(w));
