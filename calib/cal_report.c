@@ -301,9 +301,33 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
 
 // ---- every simulation ------------------------------------------------------------
 
+// The distinct simulations a calibration used: a run two stages share (two wall
+// materials with the same data, the same candidate) is counted once.
+enum { TALLY_DECIDING, TALLY_MAP, TALLY_CYLINDER, TALLY_KINDS };
+typedef struct sim_tally {
+    char (*hash)[17];
+    int n, cap;
+    int count[TALLY_KINDS];
+    double core_s[TALLY_KINDS];
+} sim_tally;
+
+static void tally_add(sim_tally *t, const char *hash, int kind, const cal_record *rec)
+{
+    for (int i = 0; i < t->n; ++i)
+        if (strcmp(t->hash[i], hash) == 0) return;
+    if (t->n == t->cap) {
+        int cap = t->cap ? 2 * t->cap : 256;
+        char(*grown)[17] = realloc(t->hash, (size_t)cap * sizeof *grown);
+        if (!grown) return; // the count is then short; the table and records are unaffected
+        t->hash = grown, t->cap = cap;
+    }
+    memcpy(t->hash[t->n++], hash, 17);
+    t->count[kind]++, t->core_s[kind] += cal_record_cost_s(rec);
+}
+
 // Candidate i's records on bed b of tier t, one row a speed.
 static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, const cal_friction_result *r, int i, int b,
-                            const char *store)
+                            const char *store, sim_tally *tally)
 {
     char stage[48];
     snprintf(stage, sizeof stage, "%s%s", r->material[0] ? r->material : "granule", t != o->tier ? " (map)" : "");
@@ -325,6 +349,7 @@ static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, co
                 i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
                 rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s, rec.wall_time_s,
                 rec.fill_wall_time_s, rec.particle_steps, rec.granules, rec.dt_s, rec.peak_rss_mb);
+        tally_add(tally, hash, t != o->tier ? TALLY_MAP : TALLY_DECIDING, &rec);
         cal_record_free(&rec);
     }
 }
@@ -332,16 +357,18 @@ static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, co
 // A stage's simulations: its own candidates', and in a two-tier stage the map
 // tier's, found through the predicted candidates that stand for them (a map
 // candidate with a failed speed has none, and is not listed).
-static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store)
+static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store,
+                           sim_tally *tally)
 {
     const cal_tier *map = o->tier->map_tier ? cal_config_tier_named(o->config, o->tier->map_tier) : NULL;
     for (int i = 0; i < r->n; ++i) {
         const cal_tier *t = r->cand[i].predicted ? map : o->tier;
-        for (int b = 0; t && b < cal_tier_beds(t); ++b) bed_simulations(f, o, t, r, i, b, store);
+        for (int b = 0; t && b < cal_tier_beds(t); ++b) bed_simulations(f, o, t, r, i, b, store, tally);
     }
 }
 
-static int write_simulations(const char *dir, const char *store, const cal_outcome *o, char *err, size_t len)
+static int write_simulations(const char *dir, const char *store, const cal_outcome *o, sim_tally *tally, char *err,
+                             size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/simulations.csv", dir);
@@ -363,10 +390,11 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
             fprintf(a.f, "stiffness,%d,%s,cylinder,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,0,,%d,%.5f,%.1f\n", i + 1,
                     hash, cd.granule.mu_s, cd.granule.mu_r, s->k[i], rec.status, rec.reason ? rec.reason : "",
                     rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination, rec.peak_rss_mb);
+            tally_add(tally, hash, TALLY_CYLINDER, &rec);
             cal_record_free(&rec);
         }
-    if (o->granule) simulations_of(a.f, o, o->granule, store);
-    for (int w = 0; w < o->n_walls; ++w) simulations_of(a.f, o, o->walls[w], store);
+    if (o->granule) simulations_of(a.f, o, o->granule, store, tally);
+    for (int w = 0; w < o->n_walls; ++w) simulations_of(a.f, o, o->walls[w], store, tally);
     return cal_atomic_commit(&a, err, len);
 }
 
@@ -476,31 +504,30 @@ static void cost_row(FILE *f, const char *stage, const char *tier, int candidate
 }
 
 // What each stage and tier ran and cost (stored simulations at the cost they
-// had), beside the paper's procedure and two reference systems.
-static void report_cost(FILE *f, const cal_outcome *o)
+// had), the distinct simulations in all, beside the paper's procedure and two
+// reference systems.
+static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
 {
     fputs("\n## What it cost\n\n| stage | tier | candidates | simulations | core-hours |\n|---|---|---|---|---|\n", f);
-    int sims = 0;
-    double core = 0;
     const cal_friction_result *stages[17] = {o->granule};
     for (int w = 0; w < o->n_walls && w < 16; ++w) stages[1 + w] = o->walls[w];
     for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
         const cal_friction_result *r = stages[i];
         if (!r) continue;
         const char *name = r->material[0] ? r->material : "granule-granule";
-        if (r->map_tier[0]) {
-            cost_row(f, name, r->map_tier, r->map_candidates, r->map_simulations, r->map_core_s);
-            sims += r->map_simulations, core += r->map_core_s;
-        }
+        if (r->map_tier[0]) cost_row(f, name, r->map_tier, r->map_candidates, r->map_simulations, r->map_core_s);
         int own = 0;
         for (int k = 0; k < r->n; ++k) own += !r->cand[k].predicted;
         cost_row(f, name, o->tier->name, own, r->simulations, r->core_s);
-        sims += r->simulations, core += r->core_s;
     }
-    fprintf(f, "\nDrum simulations in all: %d, %.2f core-hours", sims, core / 3600);
-    if (o->stiffness)
-        fprintf(f, "; and stage 1's %d poured cylinders (%.0f s wall)", o->stiffness->n * o->tier->seeds,
-                o->stiffness->wall_time_s);
+    fprintf(f, "\nDistinct simulations in all: %d, %.2f core-hours: %d drum runs at tier '%s' (%.2f)",
+            t->n, (t->core_s[TALLY_DECIDING] + t->core_s[TALLY_MAP] + t->core_s[TALLY_CYLINDER]) / 3600,
+            t->count[TALLY_DECIDING], o->tier->name, t->core_s[TALLY_DECIDING] / 3600);
+    if (o->tier->map_tier)
+        fprintf(f, ", %d at its map tier '%s' (%.2f)", t->count[TALLY_MAP], o->tier->map_tier,
+                t->core_s[TALLY_MAP] / 3600);
+    fprintf(f, ", %d poured cylinders (%.2f). A run two stages share (the same candidate for two wall materials) is "
+               "counted once here and under each stage above", t->count[TALLY_CYLINDER], t->core_s[TALLY_CYLINDER] / 3600);
     fputs(". For scale: the paper ran 14 poured cylinders for the stiffness (section 4.1) and, per drum lining, "
           "a grid of (μs, μr) pairs (Fig. 13, 17) at λ = 64, 200 000 granules, 6 s each; the reference calibration "
           "systems spend about 80 (GrainLearning) to 480 (ACCES) simulations per calibration.\n", f);
@@ -531,7 +558,7 @@ static void report_export(FILE *f, const char *dir)
     fclose(s);
 }
 
-static int write_report(const char *dir, const cal_outcome *o, char *err, size_t len)
+static int write_report(const char *dir, const cal_outcome *o, const sim_tally *tally, char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/report.md", dir);
@@ -569,7 +596,7 @@ static int write_report(const char *dir, const cal_outcome *o, char *err, size_t
     }
     if (o->granule) report_friction(f, o->granule, &o->config->granule);
     for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w], &o->config->wall);
-    report_cost(f, o);
+    report_cost(f, o, tally);
     report_export(f, dir);
     return cal_atomic_commit(&a, err, len);
 }
@@ -580,10 +607,13 @@ int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t le
     int n = table_rows(&o->table, rows);
     char store[1100];
     snprintf(store, sizeof store, "%s/store", dir);
-    if (write_table_csv(dir, rows, n, err, len) || write_table_md(dir, &o->table, err, len) ||
-        write_table_h5(dir, rows, n, err, len) || write_liggghts(dir, o, err, len) || write_lammps(dir, o, err, len) ||
-        write_simulations(dir, store, o, err, len) || write_report(dir, o, err, len))
-        return 1;
+    sim_tally tally = {0};
+    int bad = write_table_csv(dir, rows, n, err, len) || write_table_md(dir, &o->table, err, len) ||
+              write_table_h5(dir, rows, n, err, len) || write_liggghts(dir, o, err, len) ||
+              write_lammps(dir, o, err, len) || write_simulations(dir, store, o, &tally, err, len) ||
+              write_report(dir, o, &tally, err, len);
+    free(tally.hash);
+    if (bad) return 1;
     if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
     if (o->granule && cal_figures_friction(dir, &o->config->granule, o->granule, err, len)) return 1;
     for (int w = 0; w < o->n_walls; ++w)
