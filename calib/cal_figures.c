@@ -89,9 +89,11 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
 }
 
 // The objective of every candidate in evaluation order (those matching the
-// angle apart from the others), the best so far, and the chosen one.
+// angle apart from the others, and apart from both a two-tier stage's map
+// candidates, which this tier did not run and which are never chosen), the best
+// so far among this tier's runs, and the chosen one.
 typedef struct convergence_data {
-    double index[CAL_MAX_EVALS], matching[CAL_MAX_EVALS], outside[CAL_MAX_EVALS];
+    double index[CAL_MAX_EVALS], matching[CAL_MAX_EVALS], outside[CAL_MAX_EVALS], mapped[CAL_MAX_EVALS];
     double step_x[2 * CAL_MAX_EVALS], step_best[2 * CAL_MAX_EVALS]; ///< the best so far as a staircase
     double chosen_index[1], chosen_objective[1];
 } convergence_data;
@@ -103,8 +105,10 @@ static void convergence_collect(const cal_friction_result *r, convergence_data *
         const cal_candidate *k = &r->cand[i];
         int matches = k->angle_violation <= 0;
         d->index[i] = i + 1;
-        d->matching[i] = matches ? k->objective : NAN, d->outside[i] = matches ? NAN : k->objective;
-        if (r->angle_in_misfit || matches) running = fmin(running, k->objective);
+        d->mapped[i] = k->predicted ? k->objective : NAN;
+        d->matching[i] = !k->predicted && matches ? k->objective : NAN;
+        d->outside[i] = !k->predicted && !matches ? k->objective : NAN;
+        if (!k->predicted && (r->angle_in_misfit || matches)) running = fmin(running, k->objective);
         d->step_x[2 * i] = i + 1, d->step_x[2 * i + 1] = i + 2; // holds until the next evaluation
         d->step_best[2 * i] = d->step_best[2 * i + 1] = isfinite(running) ? running : NAN;
     }
@@ -119,20 +123,28 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
     convergence_collect(r, d);
     char path[1200], title[96];
     snprintf(path, sizeof path, "%s/convergence_%s.png", dir, stage_name(r));
-    snprintf(title, sizeof title, "%s: search convergence (%d evaluations)", stage_name(r), r->n);
+    int mapped = 0;
+    for (int i = 0; i < r->n; ++i) mapped += r->cand[i].predicted;
+    if (mapped)
+        snprintf(title, sizeof title, "%s: search convergence (%d runs, %d map candidates)", stage_name(r),
+                 r->n - mapped, mapped);
+    else snprintf(title, sizeof title, "%s: search convergence (%d evaluations)", stage_name(r), r->n);
     size_t n = (size_t)r->n;
-    exp_plot_series s[4] = {
+    exp_plot_series s[5] = {
         points(n, d->index, d->matching, "candidate matching the angle", blue, EXP_MARK_CIRCLE),
         points(n, d->index, d->outside, "candidate outside the angle's tolerance", grey, EXP_MARK_OPEN_CIRCLE),
         {.n = 2 * n - (n > 0), .x = d->step_x, .y = d->step_best, .rgb = {black[0], black[1], black[2]},
          .label = r->angle_in_misfit ? "best so far" : "best matching the angle so far"},
         points(1, d->chosen_index, d->chosen_objective, "chosen", red, EXP_MARK_STAR),
+        points(n, d->index, d->mapped, "map tier + measured correction (not run here, never chosen)", grey,
+               EXP_MARK_CROSS),
     };
     exp_plot_axes axes = {.title = title, .xlabel = "evaluation",
                           .ylabel = r->angle_in_misfit ? "objective: angle and CSA misfit (mean squared z)"
                                                        : "objective: CSA misfit (mean squared z)",
                           .log_y = 1};
-    int rc = exp_plot_png(path, &axes, r->best >= 0 ? 4 : 3, s, WIDTH, HEIGHT, err, len);
+    if (r->best < 0) s[3] = s[4]; // no chosen point to draw
+    int rc = exp_plot_png(path, &axes, (r->best >= 0 ? 4 : 3) + (mapped > 0), s, WIDTH, HEIGHT, err, len);
     free(d);
     return rc;
 }
