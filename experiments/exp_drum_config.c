@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -69,23 +70,22 @@ static int apply_set(exp_drum_yaml *y, const char *set, char *err, size_t len)
         *text = copy;
         return 0;
     }
+    double tilt = NAN; // optional in the file: allocated only when given
     const exp_set_key keys[] = {
         EXP_SET_NUMBER("rpm", &y->rpm), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("mu_r", &y->mu_r),
         EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("xi", &y->xi), EXP_SET_NUMBER("lambda", &y->lambda),
         EXP_SET_INTEGER("seed", &y->seed), EXP_SET_NUMBER("fill", &y->fill),
-        EXP_SET_NUMBER("slice_depth", &y->slice_depth), EXP_SET_NUMBER("max_time", &y->max_time)};
+        EXP_SET_NUMBER("slice_depth", &y->slice_depth), EXP_SET_NUMBER("max_time", &y->max_time),
+        EXP_SET_NUMBER("start_tilt_deg", &tilt)};
     const size_t n = sizeof keys / sizeof *keys;
     int found = exp_set_key_value(keys, n, key, value, err, len);
-    if (found >= 0) return found;
-    double v;
-    if (strcmp(key, "start_tilt_deg") == 0) {
-        if (exp_parse_number(value, &v)) return exp_fail(err, len, "--set %s: '%s' is not a number", key, value);
+    if (found < 0) return exp_set_unknown(keys, n, "wall, fill_method", key, err, len);
+    if (found == 0 && !isnan(tilt)) {
         if (!y->start_tilt_deg && !(y->start_tilt_deg = malloc(sizeof *y->start_tilt_deg)))
             return exp_fail(err, len, "out of memory");
-        *y->start_tilt_deg = v;
-        return 0;
+        *y->start_tilt_deg = tilt;
     }
-    return exp_set_unknown(keys, n, "wall, start_tilt_deg, fill_method", key, err, len);
+    return found;
 }
 
 static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char *name)

@@ -65,6 +65,8 @@ static void test_bad_values_named(void **state)
     expect_error("wall=teflon", "teflon");
     expect_error("fill=1.2", "fill");
     expect_error("lambda=0.5", "lambda");
+    expect_error("start_tilt_deg=120", "start_tilt_deg"); // the optional field, allocated by the override
+    expect_error("start_tilt_deg=steep", "not a number");
     expect_error("colour=red", "unknown key");
     expect_error("rpm", "key=value");
 }
