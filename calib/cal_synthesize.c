@@ -7,6 +7,7 @@
 // cal_drum_case_wall) on seeds the calibration does not use, so the data
 // differ from any candidate's run by the tier's seed noise, as lab data
 // differ from the model by the powder's.
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -20,6 +21,7 @@
 #include "cal_mpi.h"
 #include "cal_sim.h"
 #include "cal_stages.h"
+#include "cal_store.h"
 #include "cal_util.h"
 #include "exp_common.h"
 
@@ -51,6 +53,10 @@ static const char help[] =
     "  --seeds A,B,...       drum seeds (default 101,102,103; the config's seed, which the\n"
     "                        calibration's candidates use, is refused)\n"
     "  --out DIR             (default results/synthetic-<tier>); runs kept in DIR/store\n"
+    "  --reuse STORE         another run's store (e.g. a fidelity study's) to take\n"
+    "                        records from: a simulation found there under the same key\n"
+    "                        (drum, pairs, seed, speed, tier, results version) is\n"
+    "                        copied into DIR/store byte for byte, not run again\n"
     "  --jobs N              simulations side by side (default: cores)\n"
     "  -h, --help            this text\n"
     "\n"
@@ -63,7 +69,7 @@ typedef struct pair {
 } pair;
 
 typedef struct options {
-    const char *config, *tier, *out;
+    const char *config, *tier, *out, *reuse;
     pair granule, walls[MAX_WALLS];
     int n_walls, has_granule, jobs, n_seeds;
     double k_n; ///< NAN: the config's
@@ -103,7 +109,8 @@ static int parse_options(int argc, char **argv, options *o)
 {
     static const struct option longs[] = {{"tier", 1, 0, 't'},  {"granule", 1, 0, 'g'}, {"wall", 1, 0, 'w'},
                                           {"k-n", 1, 0, 'k'},   {"seeds", 1, 0, 's'},   {"out", 1, 0, 'o'},
-                                          {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},    {0, 0, 0, 0}};
+                                          {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},    {"reuse", 1, 0, 'r'},
+                                          {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .k_n = NAN, .n_seeds = 3, .seeds = {101, 102, 103},
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
     optind = 1;
@@ -112,6 +119,7 @@ static int parse_options(int argc, char **argv, options *o)
         switch (ch) {
         case 't': o->tier = optarg; break;
         case 'o': o->out = optarg; break;
+        case 'r': o->reuse = optarg; break;
         case 'g':
             if (parse_pair(optarg, &o->granule.mu_s, &o->granule.mu_r))
                 return bad_option("--granule", optarg, "need MU_S,MU_R, both > 0");
@@ -235,6 +243,47 @@ typedef struct lining_result {
     summary angle[CAL_MAX_RPM], csa[CAL_MAX_RPM];
 } lining_result;
 
+// A record of the same simulation in the --reuse store, copied byte for byte
+// (its writer stays the run that made it). The key names everything that
+// defines the run, and cal_store_get checks the whole key, not just its hash.
+// 0: copied, or nothing to copy (already here, or absent there: it will run).
+static int copy_record(const char *from_dir, const char *to_dir, const char *key, int *copied, char *err, size_t len)
+{
+    char from[1200], to[1200];
+    cal_store_path(to_dir, key, to, sizeof to);
+    if (access(to, F_OK) == 0) return 0;
+    cal_record r;
+    int found = cal_store_get(from_dir, key, &r, err, len);
+    if (found != 0) return found < 0;
+    cal_record_free(&r);
+    cal_store_path(from_dir, key, from, sizeof from);
+    FILE *in = fopen(from, "rb");
+    if (!in) return exp_fail(err, len, "%s: %s", from, strerror(errno));
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, to, err, len)) return fclose(in), 1;
+    char buf[8192];
+    for (size_t n; (n = fread(buf, 1, sizeof buf, in)) > 0;) fwrite(buf, 1, n, a.f);
+    int unread = ferror(in);
+    fclose(in);
+    if (unread) return cal_atomic_abort(&a), exp_fail(err, len, "%s: read error", from);
+    ++*copied;
+    return cal_atomic_commit(&a, err, len);
+}
+
+// Every seed and speed of a lining that the --reuse store already holds.
+static int reuse_records(job *j, const cal_drum_case *cases, int n)
+{
+    int copied = 0;
+    for (int s = 0; s < n; ++s)
+        for (int k = 0; k < j->n_rpm; ++k) {
+            char key[2048];
+            cal_drum_key(&cases[s], j->rpm[k], key, sizeof key);
+            if (copy_record(j->opt.reuse, j->env.store, key, &copied, j->err, sizeof j->err)) return 1;
+        }
+    if (copied) fprintf(stderr, "   %d of %d run(s) taken from %s\n", copied, n * j->n_rpm, j->opt.reuse);
+    return 0;
+}
+
 // Run (or read from the store) one lining's seeds; a speed with no usable
 // run is an error: the data would have a hole the calibration would trip on.
 static int make_lining(job *j, const lining *l, lining_result *out)
@@ -244,6 +293,7 @@ static int make_lining(job *j, const lining *l, lining_result *out)
     cal_record *rec = calloc((size_t)(n * j->n_rpm), sizeof *rec);
     if (!rec) return exp_fail(j->err, sizeof j->err, "out of memory");
     for (int s = 0; s < n; ++s) cases[s] = case_of(j, l, j->opt.seeds[s]);
+    if (j->opt.reuse && reuse_records(j, cases, n)) return free(rec), 1;
     cal_env_set_stage(&j->env, l->surface);
     if (cal_drum_evaluate_many(&j->env, cases, n, j->rpm, j->n_rpm, rec, j->err, sizeof j->err)) return free(rec), 1;
     int bad = 0;
@@ -315,6 +365,8 @@ static int prepare(job *j)
     if (choose_speeds(j) || choose_linings(j)) return 1;
     if (j->opt.out) snprintf(j->out, sizeof j->out, "%s", j->opt.out);
     else snprintf(j->out, sizeof j->out, "results/synthetic-%.60s", j->t->name);
+    if (j->opt.reuse && access(j->opt.reuse, R_OK | X_OK) != 0)
+        return exp_fail(j->err, sizeof j->err, "--reuse %s: %s", j->opt.reuse, strerror(errno));
     if (cal_prepare_output(j->out, j->err, sizeof j->err)) return 1;
     snprintf(j->env.store, sizeof j->env.store, "%s/store", j->out);
     j->env.workers = j->opt.jobs, j->env.use_fork = cal_mpi_size() == 1, j->env.tty = isatty(2);
