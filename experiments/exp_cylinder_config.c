@@ -90,19 +90,6 @@ static int apply_set(cylinder_yaml *y, const char *set, char *err, size_t len)
     return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
 }
 
-// The error for `field`: from a --set if one gave it, else located in the file.
-static int located(const char *path, int n_sets, char **sets, const char *field, const char *msg, char *err, size_t len)
-{
-    for (int k = n_sets - 1; k >= 0; --k) {
-        size_t n = strlen(field);
-        if (strncmp(sets[k], field, n) == 0 && sets[k][n] == '=')
-            return exp_fail(err, len, "--set %s: %s", sets[k], msg);
-    }
-    int line = exp_yaml_line_of(path, field, 1);
-    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
-    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
-}
-
 int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_def *d, char *err, size_t len)
 {
     cylinder_yaml *y = NULL;
@@ -113,10 +100,10 @@ int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_de
     int bad = 0;
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
     if (!bad && strcmp(y->experiment, "cylinder") != 0)
-        bad = located(path, 0, NULL, "experiment", "must be cylinder", err, len);
+        bad = exp_field_error(path, 0, NULL, "experiment", "must be cylinder", err, len);
     if (!bad && y->seed < 0) {
         snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
-        bad = located(path, 0, NULL, "seed", msg, err, len);
+        bad = exp_field_error(path, 0, NULL, "seed", msg, err, len);
     }
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_cylinder_check(d, msg, sizeof msg))) {
         // Messages start with the field: "depth = ...", "granule_contact.mu_s = ...",
@@ -124,7 +111,7 @@ int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_de
         char field[48];
         snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
         const char *leaf = strrchr(field, '.');
-        bad = located(path, n_sets, sets, leaf ? leaf + 1 : field, msg, err, len);
+        bad = exp_field_error(path, n_sets, sets, leaf ? leaf + 1 : field, msg, err, len);
     }
     exp_yaml_free(&cylinder_schema, y);
     return bad;

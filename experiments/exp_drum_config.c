@@ -95,16 +95,21 @@ static const exp_material_yaml *find_material(const exp_drum_yaml *y, const char
     return NULL;
 }
 
-static int located(const char *path, const char *field, char *err, size_t len, const char *fmt, ...)
+/// Where a config's values came from: the file, then its --set overrides.
+typedef struct source {
+    const char *path;
+    int n_sets;
+    char **sets;
+} source;
+
+static int located(const source *from, const char *field, char *err, size_t len, const char *fmt, ...)
 {
     char msg[256];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    int line = exp_yaml_line_of(path, field, 1);
-    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
-    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
+    return exp_field_error(from->path, from->n_sets, from->sets, field, msg, err, len);
 }
 
 int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run_opts *run, char *err, size_t len)
@@ -135,9 +140,9 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     return 0;
 }
 
-static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t len)
+static int validate(const source *from, const exp_drum_yaml *y, char *err, size_t len)
 {
-    if (strcmp(y->experiment, "drum") != 0) return located(path, "experiment", err, len, "must be drum");
+    if (strcmp(y->experiment, "drum") != 0) return located(from, "experiment", err, len, "must be drum");
     // libcyaml reads inf and nan as numbers; the range checks below let inf through.
     const struct { const char *key; double v; } numbers[] = {
         {"diameter", y->diameter}, {"depth", y->depth}, {"fill", y->fill}, {"slice_depth", y->slice_depth},
@@ -147,21 +152,21 @@ static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t 
         {"sample_interval", y->sample_interval}, {"pixel", y->pixel}};
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (!isfinite(numbers[k].v))
-            return located(path, numbers[k].key, err, len, "%g must be a finite number", numbers[k].v);
+            return located(from, numbers[k].key, err, len, "%g must be a finite number", numbers[k].v);
     if (y->start_tilt_deg && !(*y->start_tilt_deg >= 0 && *y->start_tilt_deg <= 90))
-        return located(path, "start_tilt_deg", err, len, "%g must be in [0, 90] degrees", *y->start_tilt_deg);
-    if (y->window < 0) return located(path, "window", err, len, "%g must be >= 0 (0 or absent: 1 s)", y->window);
+        return located(from, "start_tilt_deg", err, len, "%g must be in [0, 90] degrees", *y->start_tilt_deg);
+    if (y->window < 0) return located(from, "window", err, len, "%g must be >= 0 (0 or absent: 1 s)", y->window);
     if (y->sample_interval < 0)
-        return located(path, "sample_interval", err, len, "%g must be >= 0 (0 or absent: 0.05 s)", y->sample_interval);
-    if (!(y->rpm >= 0 && y->rpm <= 1000)) return located(path, "rpm", err, len, "%g must be in [0, 1000]", y->rpm);
-    if (!(y->max_time > 0)) return located(path, "max_time", err, len, "%g must be > 0", y->max_time);
+        return located(from, "sample_interval", err, len, "%g must be >= 0 (0 or absent: 0.05 s)", y->sample_interval);
+    if (!(y->rpm >= 0 && y->rpm <= 1000)) return located(from, "rpm", err, len, "%g must be in [0, 1000]", y->rpm);
+    if (!(y->max_time > 0)) return located(from, "max_time", err, len, "%g must be > 0", y->max_time);
     if (y->periodic && !(y->slice_depth > 0))
-        return located(path, "slice_depth", err, len, "%g must be > 0 for a periodic slice", y->slice_depth);
-    if (!(y->k_n > 0)) return located(path, "k_n", err, len, "%g must be > 0", y->k_n);
+        return located(from, "slice_depth", err, len, "%g must be > 0 for a periodic slice", y->slice_depth);
+    if (!(y->k_n > 0)) return located(from, "k_n", err, len, "%g must be > 0", y->k_n);
     for (unsigned k = 0; k < y->materials_count; ++k)
         if (!(isfinite(y->materials[k].mu_s) && y->materials[k].mu_s >= 0) ||
             !(isfinite(y->materials[k].mu_r) && y->materials[k].mu_r >= 0))
-            return located(path, "materials", err, len, "'%s': friction must be finite and >= 0", y->materials[k].name);
+            return located(from, "materials", err, len, "'%s': friction must be finite and >= 0", y->materials[k].name);
     exp_drum_def def;
     exp_drum_run_opts run;
     char msg[300];
@@ -169,7 +174,7 @@ static int validate(const char *path, const exp_drum_yaml *y, char *err, size_t 
         char field[48];
         snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
         const char *leaf = strrchr(field, '.');
-        return located(path, leaf ? leaf + 1 : field, err, len, "%s", msg);
+        return located(from, leaf ? leaf + 1 : field, err, len, "%s", msg);
     }
     return 0;
 }
@@ -185,7 +190,7 @@ exp_drum_yaml *exp_drum_config_load(const char *path, int n_sets, char **sets, c
             exp_drum_config_free(y);
             return NULL;
         }
-    if (validate(path, y, err, len)) {
+    if (validate(&(source){path, n_sets, sets}, y, err, len)) {
         exp_drum_config_free(y);
         return NULL;
     }

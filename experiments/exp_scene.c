@@ -107,6 +107,18 @@ int exp_yaml_line_of(const char *path, const char *key, int from_line)
     return found;
 }
 
+int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
+                    size_t len)
+{
+    size_t n = strlen(field);
+    for (int k = n_sets - 1; k >= 0; --k)
+        if (strncmp(sets[k], field, n) == 0 && sets[k][n] == '=')
+            return exp_fail(err, len, "%s: --set %s: %s", path, sets[k], msg);
+    int line = exp_yaml_line_of(path, field, 1);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
+}
+
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len)
 {

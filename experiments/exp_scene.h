@@ -64,4 +64,11 @@ int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, co
 /// YAML library reports only the field.
 int exp_yaml_line_of(const char *path, const char *key, int from_line);
 
+/// The error for a config field whose value is bad, pointed at where the value
+/// came from: "PATH: --set FIELD=V: MSG" when the last `--set` of that field
+/// (among sets[0..n_sets)) gave it, else "PATH:LINE: FIELD: MSG" at the field's
+/// line in the file ("PATH: FIELD: MSG" if the line is not found). Always 1.
+int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
+                    size_t len);
+
 #endif

@@ -58,7 +58,7 @@ static void expect_error(char *set, const char *needle)
 static void test_bad_values_named(void **state)
 {
     (void)state;
-    expect_error("rpm=-4", "drum.yaml:");        // file and line
+    expect_error("rpm=-4", "drum.yaml: --set rpm=-4: "); // the file, and the --set that gave the value
     expect_error("rpm=-4", "rpm");               // field
     expect_error("mu_s=-0.1", "mu_s");
     expect_error("mu_r=nan", "not a number");
