@@ -25,6 +25,7 @@ static const cyaml_schema_value_t material_entry = {CYAML_VALUE_MAPPING(CYAML_FL
 
 // A strict yes/no: libcyaml's bool reads any word but a few as true.
 static const cyaml_strval_t yes_no[] = {{"false", 0}, {"true", 1}, {"no", 0}, {"yes", 1}};
+static const cyaml_strval_t corrections[] = {{"kriging", CAL_MF_KRIGING}, {"affine", CAL_MF_AFFINE}};
 
 #define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
 static const cyaml_schema_field_t tier_fields[] = {
@@ -53,6 +54,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_ENUM_PTR("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, bound_probes, yes_no,
                          CYAML_ARRAY_LEN(yes_no)),
     CYAML_FIELD_STRING_PTR("map_tier", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, map_tier, 1, 31),
+    CYAML_FIELD_ENUM_PTR("map_correction", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, map_correction, corrections,
+                         CYAML_ARRAY_LEN(corrections)),
     CYAML_FIELD_INT("beds", CYAML_FLAG_OPTIONAL, cal_tier, beds),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
@@ -258,12 +261,18 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
             return located(c, from, "csa_sd_percent", err, len, "%g must be in [0, 50) percentage points",
                            t->csa_sd_percent[k]);
     if (check_average_per_rpm(c, t, from, err, len)) return 1;
+    if (t->map_correction && !t->map_tier)
+        return located(c, from, "map_correction", err, len, "only a tier with a map_tier corrects a map");
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
 }
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
 int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
+cal_mf_correction_kind cal_tier_map_correction(const cal_tier *t)
+{
+    return t->map_correction ? (cal_mf_correction_kind)*t->map_correction : CAL_MF_KRIGING;
+}
 double cal_tier_csa_sd(const cal_tier *t, unsigned i)
 {
     if (t->csa_sd_percent_count == 0) return 0;

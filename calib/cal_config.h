@@ -8,6 +8,7 @@
 #define CAL_CONFIG_H
 
 #include <stddef.h>
+#include "cal_multifidelity.h"
 
 /// A wall material to fit: its name in the table and its drum lining's name
 /// in the lab data files.
@@ -67,6 +68,9 @@ typedef struct cal_tier {
     /// measures between the two, puts the optimum; max_evaluations bounds
     /// those runs and grid is unused. NULL: a one-tier search.
     char *map_tier;
+    /// How the discrepancy measured at this tier's runs corrects the map
+    /// (cal_mf_correction_kind; absent: kriging).
+    int *map_correction;
     /// Beds each drum candidate is run on (seeds seed, seed+1, ...), its
     /// measurements the mean over them. angle_sd_deg and csa_sd_percent stay
     /// one bed's spreads, as measured; the search divides them by sqrt(beds)
@@ -80,6 +84,8 @@ int cal_tier_angle_in_misfit(const cal_tier *t);
 int cal_tier_beds(const cal_tier *t);
 /// 1 if the tier probes the μr bounds after the search (the default).
 int cal_tier_bound_probes(const cal_tier *t);
+/// The tier's map_correction (kriging when absent).
+cal_mf_correction_kind cal_tier_map_correction(const cal_tier *t);
 /// The tier's CSA spread at speed index i of its rpm list (0: not measured).
 double cal_tier_csa_sd(const cal_tier *t, unsigned i);
 /// Seconds a run at `rpm` averages after its steady test: average_time_per_rpm's

@@ -4,6 +4,8 @@
 // only there.
 #include "cal_multifidelity.h"
 
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multifit.h>
 #include <math.h>
 #include <nlopt.h>
@@ -44,9 +46,30 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
     return 0;
 }
 
+const char *cal_mf_correction_name(cal_mf_correction_kind kind) { return kind == CAL_MF_AFFINE ? "affine" : "kriging"; }
+
+static double kernel(double u1, double v1, double u2, double v2)
+{
+    const double l = CAL_MF_KRIGING_LENGTH;
+    return exp(-((u1 - u2) * (u1 - u2) + (v1 - v2) * (v1 - v2)) / (2 * l * l));
+}
+
+// The correction's plane (its affine part) for measurement k at (u, v).
+static double plane_at(const cal_mf_correction *c, int k, double u, double v)
+{
+    return c->at[k] + c->du[k] * (u - c->u0) + c->dv[k] * (v - c->v0);
+}
+
 void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, double *y)
 {
-    for (int k = 0; c && k < n_y; ++k) y[k] += c->at[k] + c->du[k] * (u - c->u0) + c->dv[k] * (v - c->v0);
+    if (!c) return;
+    double k_at[CAL_MF_MAX_FINE];
+    for (int i = 0; i < c->n_runs; ++i) k_at[i] = kernel(u, v, c->run_u[i], c->run_v[i]);
+    for (int k = 0; k < n_y; ++k) {
+        double sum = plane_at(c, k, u, v);
+        for (int i = 0; i < c->n_runs; ++i) sum += c->weight[k][i] * k_at[i];
+        y[k] += sum;
+    }
 }
 
 void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y)
@@ -124,6 +147,39 @@ static int measured(const cal_mf_point *p, int n_y)
     return 1;
 }
 
+// Kriging of what the plane leaves at the runs, per measurement: weights w
+// solving (K + r·I) w = residuals, K the kernel between the runs and r the
+// runs' own noise over the residuals' scale, (noise / max(rms, noise))²: near
+// 0 (interpolation) when the residuals stand well above the noise, 1 (a
+// smoothed fit) when they are noise; at least 1e-9, to keep K + r·I positive
+// definite. The weights stay 0 for a measurement whose system GSL cannot
+// factor.
+static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], const double *u, const double *v, int m,
+                            int n_y, const double *run_noise)
+{
+    c->n_runs = m;
+    for (int i = 0; i < m; ++i) c->run_u[i] = u[i], c->run_v[i] = v[i];
+    gsl_matrix *K = gsl_matrix_alloc((size_t)m, (size_t)m);
+    gsl_vector *r = gsl_vector_alloc((size_t)m), *w = gsl_vector_alloc((size_t)m);
+    for (int k = 0; K && r && w && k < n_y; ++k) {
+        double ss = 0;
+        for (int i = 0; i < m; ++i) {
+            double e = d[i][k] - plane_at(c, k, u[i], v[i]);
+            gsl_vector_set(r, (size_t)i, e), ss += e * e;
+        }
+        double noise = run_noise ? run_noise[k] : 0, scale = fmax(sqrt(ss / m), noise);
+        double ratio = scale > 0 ? noise * noise / (scale * scale) : 1;
+        for (int i = 0; i < m; ++i)
+            for (int j = 0; j < m; ++j)
+                gsl_matrix_set(K, (size_t)i, (size_t)j, kernel(u[i], v[i], u[j], v[j]) + (i == j ? fmax(ratio, 1e-9) : 0));
+        gsl_error_handler_t *old = gsl_set_error_handler_off();
+        int bad = gsl_linalg_cholesky_decomp1(K) || gsl_linalg_cholesky_solve(K, r, w);
+        gsl_set_error_handler(old);
+        for (int i = 0; i < m; ++i) c->weight[k][i] = bad ? 0 : gsl_vector_get(w, (size_t)i);
+    }
+    gsl_matrix_free(K), gsl_vector_free(r), gsl_vector_free(w);
+}
+
 // A least-squares slope from the centred sums of squares and cross products.
 static double slope(double sxx, double sxd) { return sxx > 0 ? sxd / sxx : 0; }
 
@@ -131,8 +187,9 @@ static double slope(double sxx, double sxd) { return sxx > 0 ? sxd / sxx : 0; }
 // everything, its mean at their centre and, with three runs or more, its
 // slopes along each direction they span (least squares on the centred
 // coordinates: both at once where both are spanned).
-static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, int n_y)
+static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const cal_mf_problem *p)
 {
+    const int n_y = p->n_y;
     enum { MIN_RUNS_FOR_SLOPES = 3 };
     const double min_span = 0.05;
     double d[CAL_MF_MAX_FINE][CAL_MF_MAX_Y], u[CAL_MF_MAX_FINE], v[CAL_MF_MAX_FINE];
@@ -170,6 +227,7 @@ static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, int n_y
         else if (use_u) c->du[k] = slope(suu, sud);
         else if (use_v) c->dv[k] = slope(svv, svd);
     }
+    if (p->correction == CAL_MF_KRIGING && m >= 2) krige_residuals(c, d, u, v, m, n_y, p->run_noise);
 }
 
 int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out)
@@ -188,7 +246,7 @@ int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_resul
         if (p->run_expensive(u, v, run->y, p->ctx)) return out->failed = 1, 0;
         out->agreed = agrees(run->y, out->predicted[out->n], p);
         out->n++;
-        update_correction(cheap, out, p->n_y);
+        update_correction(cheap, out, p);
         memset(out->delta, 0, sizeof out->delta);
         cal_mf_correct(&out->correction, p->n_y, u, v, out->delta);
         if (out->agreed) return 0;

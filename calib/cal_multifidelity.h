@@ -6,8 +6,8 @@
 /// expensive (converged) tier is run only where the map says the optimum is,
 /// and at each such point the program measures the discrepancy between the
 /// two tiers; the map, corrected by the discrepancy so far (per measurement:
-/// its mean, and once three runs span a direction of the plane, its slope
-/// along it, by least squares), gives the next optimum. The search ends when
+/// a plane fitted to it and, by default, a kriging interpolation of what the
+/// plane leaves, cal_mf_correction_kind), gives the next optimum. The search ends when
 /// an expensive run agrees with what the corrected map predicted for it
 /// within the data's noise, or its budget of expensive runs is spent.
 ///
@@ -41,12 +41,32 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map);
 /// The map at (u, v).
 void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y);
 
+/// How the discrepancy measured at the expensive runs is carried over the
+/// square. AFFINE: least squares of a plane (its mean at the runs' centre, and
+/// its slope along each direction three runs or more span), which does not
+/// pass through the runs when the discrepancy curves between them. KRIGING:
+/// that plane plus a Gaussian-process interpolation of its residuals (the
+/// plane is the kriging trend), so the corrected map goes through every run
+/// up to the runs' noise, and far from them falls back to the plane.
+typedef enum cal_mf_correction_kind { CAL_MF_KRIGING = 0, CAL_MF_AFFINE = 1 } cal_mf_correction_kind;
+
+/// "kriging" or "affine", as a config names it.
+const char *cal_mf_correction_name(cal_mf_correction_kind kind);
+
+/// Length of the kriging kernel exp(-d²/2ℓ²) in the unit square: the
+/// discrepancy is taken to be smooth over a quarter of the search range.
+#define CAL_MF_KRIGING_LENGTH 0.25
+
 /// The measured discrepancy between the tiers, per measurement: its value
 /// at (u0, v0), the runs' centre, and its slopes along u and v (0 along a
-/// direction the runs do not span by 0.05, or with fewer than three runs).
+/// direction the runs do not span by 0.05, or with fewer than three runs);
+/// with kriging, the kernel weights of the runs' residuals from that plane.
 typedef struct cal_mf_correction {
     double at[CAL_MF_MAX_Y], du[CAL_MF_MAX_Y], dv[CAL_MF_MAX_Y];
     double u0, v0;
+    int n_runs; ///< runs carrying kernel weights (0: the plane alone)
+    double run_u[CAL_MF_MAX_FINE], run_v[CAL_MF_MAX_FINE];
+    double weight[CAL_MF_MAX_Y][CAL_MF_MAX_FINE];
 } cal_mf_correction;
 
 /// Add the correction at (u, v) to y (n_y measurements); c NULL: nothing.
@@ -62,7 +82,11 @@ typedef struct cal_mf_problem {
     /// nonzero when the run could not be done at all (the loop stops).
     int (*run_expensive)(double u, double v, double *y, void *ctx);
     const double *noise; ///< per measurement: how far a run may be from the prediction and agree
+    /// Per measurement: the expensive runs' own noise (the tier's seed spread
+    /// of a candidate), which kriging smooths rather than interpolates; NULL: 0.
+    const double *run_noise;
     int max_expensive;   ///< budget of expensive runs (≤ CAL_MF_MAX_FINE)
+    cal_mf_correction_kind correction;
     void *ctx;
 } cal_mf_problem;
 

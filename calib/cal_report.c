@@ -450,9 +450,10 @@ static void report_two_tier(FILE *f, const cal_friction_result *r)
     for (int i = 0; i < r->n; ++i) predicted += r->cand[i].predicted;
     fprintf(f, "Two tiers: tier '%s' mapped the plane (%d candidates, %.0f s); this tier ran %d candidate(s) where the "
                "corrected map put the optimum (%.0f s). Outcome: %s. The correction measured between the "
-               "tiers (this tier minus the map, fitted to its runs, at the last run): angle %+.2f°",
+               "tiers (this tier minus the map, carried over the plane by %s, at the last run): angle %+.2f°",
             r->map_tier, r->map_candidates, r->map_wall_time_s, r->expensive_candidates, r->wall_time_s,
-            r->two_tier_outcome ? r->two_tier_outcome : "not run", r->correction[0]);
+            r->two_tier_outcome ? r->two_tier_outcome : "not run", r->map_correction ? r->map_correction : "-",
+            r->correction[0]);
     for (int j = 0; j < r->n_rpm; ++j) fprintf(f, ", CSA at %g rpm %+.2f points", r->rpm[j], r->correction[1 + j]);
     fprintf(f, ". The %d candidates marked \"map + correction\" below are the map tier's runs plus the correction where "
                "they stand, "

@@ -162,12 +162,16 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
         return cal_friction_finish(tt.search) || exp_fail(err, len, "%s: %s (tier '%s')", env->stage, out->two_tier_outcome,
                                                           map_tier->name);
     }
-    double noise[CAL_MF_MAX_Y];
-    noise[0] = out->angle_tolerance;
-    for (int i = 0; i < out->n_rpm; ++i) noise[1 + i] = cal_friction_csa_spread(out, i);
-    cal_mf_problem p = {.n_y = n_y, .objective = map_objective, .run_expensive = run_here, .noise = noise,
-                        .max_expensive = t->max_evaluations, .ctx = &tt};
-    fprintf(stderr, "-- tier '%s' where the corrected map puts the optimum (at most %d runs)\n", t->name, t->max_evaluations);
+    // Agreement within the data's noise (the lab's and the tier's); kriging
+    // smooths only the tier's own (a candidate's seed spread).
+    double noise[CAL_MF_MAX_Y], run_noise[CAL_MF_MAX_Y];
+    noise[0] = out->angle_tolerance, run_noise[0] = t->angle_sd_deg / sqrt(cal_tier_beds(t));
+    for (int i = 0; i < out->n_rpm; ++i) noise[1 + i] = cal_friction_csa_spread(out, i), run_noise[1 + i] = out->csa_tier_sd[i];
+    cal_mf_problem p = {.n_y = n_y, .objective = map_objective, .run_expensive = run_here, .noise = noise, .run_noise = run_noise,
+                        .max_expensive = t->max_evaluations, .ctx = &tt, .correction = cal_tier_map_correction(t)};
+    out->map_correction = cal_mf_correction_name(p.correction);
+    fprintf(stderr, "-- tier '%s' where the corrected map puts the optimum (at most %d runs; correction: %s)\n", t->name,
+            t->max_evaluations, out->map_correction);
     cal_mf_result *m = calloc(1, sizeof *m);
     if (!m) return cal_friction_finish(tt.search), exp_fail(err, len, "out of memory");
     cal_mf_search(&map, &p, m);

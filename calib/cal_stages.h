@@ -108,6 +108,7 @@ typedef struct cal_friction_result {
     double correction[CAL_MAX_RPM + 1]; ///< at the last run (cal_mf_result.delta)
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
+    const char *map_correction;         ///< "kriging" or "affine" (cal_mf_correction_kind)
 } cal_friction_result;
 
 /// A candidate's scores from its measurements (angle_deg, csa, usable):
