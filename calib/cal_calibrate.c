@@ -229,6 +229,31 @@ typedef struct run {
 static void plan_progress(run *r);
 static int check_predicted_cost(run *r);
 
+// Where a data file is read from: --data DIR's file of that name, else the config's.
+static void data_path(const run *r, const char *name, const char *configured, char *out, size_t len)
+{
+    if (r->opt.data) snprintf(out, len, "%s/%s", r->opt.data, name);
+    else cal_config_data_path(r->c, configured, out, len);
+}
+
+// The inputs this run read, copied into its results folder (config.yaml,
+// repose_angle.csv, occupied_area.csv): its table can be re-derived from the
+// folder alone (tests/calibration/verify_committed.sh) whatever the shipped
+// config and data become.
+static int keep_inputs(run *r)
+{
+    char from[1200], to[1200];
+    snprintf(to, sizeof to, "%s/config.yaml", r->out);
+    if (cal_copy_file(r->c->path, to, r->err, sizeof r->err)) return 1;
+    const char *names[2] = {"repose_angle.csv", "occupied_area.csv"}, *configured[2] = {r->c->repose_angle, r->c->occupied_area};
+    for (int k = 0; k < 2; ++k) {
+        data_path(r, names[k], configured[k], from, sizeof from);
+        snprintf(to, sizeof to, "%s/%s", r->out, names[k]);
+        if (cal_copy_file(from, to, r->err, sizeof r->err)) return 1;
+    }
+    return 0;
+}
+
 // Everything checked, the plan predicted, then the results folder made: a
 // refused run leaves nothing behind.
 static int prepare(run *r)
@@ -237,11 +262,9 @@ static int prepare(run *r)
     r->c = cal_config_load(r->opt.config, r->opt.tier, r->err, sizeof r->err);
     if (!r->c) return 1;
     r->t = cal_config_tier(r->c);
-    if (r->opt.data) snprintf(path, sizeof path, "%s/repose_angle.csv", r->opt.data);
-    else cal_config_data_path(r->c, r->c->repose_angle, path, sizeof path);
+    data_path(r, "repose_angle.csv", r->c->repose_angle, path, sizeof path);
     if (cal_series_load(&r->angles, path, CAL_DATA_ANGLE, r->err, sizeof r->err)) return 1;
-    if (r->opt.data) snprintf(path, sizeof path, "%s/occupied_area.csv", r->opt.data);
-    else cal_config_data_path(r->c, r->c->occupied_area, path, sizeof path);
+    data_path(r, "occupied_area.csv", r->c->occupied_area, path, sizeof path);
     if (cal_series_load(&r->areas, path, CAL_DATA_CSA, r->err, sizeof r->err)) return 1;
     if (check_surface(&r->angles, &r->areas, r->c->granule_surface, r->err, sizeof r->err)) return 1;
     int found = r->opt.material == NULL;
@@ -262,7 +285,8 @@ static int prepare(run *r)
         stem[strcspn(stem, ".")] = '\0';
         snprintf(r->out, sizeof r->out, "results/%.900s-%.60s", stem, r->t->name);
     }
-    return cal_prepare_output(r->out, r->err, sizeof r->err);
+    if (cal_prepare_output(r->out, r->err, sizeof r->err)) return 1;
+    return cal_mpi_rank() == 0 ? keep_inputs(r) : 0;
 }
 
 static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }

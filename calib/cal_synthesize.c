@@ -257,17 +257,8 @@ static int copy_record(const char *from_dir, const char *to_dir, const char *key
     if (found != 0) return found < 0;
     cal_record_free(&r);
     cal_store_path(from_dir, key, from, sizeof from);
-    FILE *in = fopen(from, "rb");
-    if (!in) return exp_fail(err, len, "%s: %s", from, strerror(errno));
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, to, err, len)) return fclose(in), 1;
-    char buf[8192];
-    for (size_t n; (n = fread(buf, 1, sizeof buf, in)) > 0;) fwrite(buf, 1, n, a.f);
-    int unread = ferror(in);
-    fclose(in);
-    if (unread) return cal_atomic_abort(&a), exp_fail(err, len, "%s: read error", from);
     ++*copied;
-    return cal_atomic_commit(&a, err, len);
+    return cal_copy_file(from, to, err, len);
 }
 
 // Every seed and speed of a lining that the --reuse store already holds.

@@ -90,6 +90,22 @@ void cal_atomic_abort(cal_atomic_file *a)
     unlink(a->tmp);
 }
 
+int cal_copy_file(const char *from, const char *to, char *err, size_t err_len)
+{
+    struct stat a, b;
+    if (stat(from, &a) == 0 && stat(to, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) return 0;
+    FILE *in = fopen(from, "rb");
+    if (!in) return snprintf(err, err_len, "cannot read '%s': %s", from, strerror(errno)), 1;
+    cal_atomic_file out;
+    if (cal_atomic_open(&out, to, err, err_len)) return fclose(in), 1;
+    char buf[8192];
+    for (size_t n; (n = fread(buf, 1, sizeof buf, in)) > 0;) fwrite(buf, 1, n, out.f);
+    int unread = ferror(in);
+    fclose(in);
+    if (unread) return cal_atomic_abort(&out), snprintf(err, err_len, "cannot read '%s'", from), 1;
+    return cal_atomic_commit(&out, err, err_len);
+}
+
 
 /// Parse "NAME.HOST.PID.tmp"; 1 and the pid when the host is this one.
 static int temporary_of_this_host(const char *name, const char *host, long *pid)

@@ -34,6 +34,10 @@ int cal_atomic_open(cal_atomic_file *a, const char *path, char *err, size_t err_
 int cal_atomic_commit(cal_atomic_file *a, char *err, size_t err_len);
 void cal_atomic_abort(cal_atomic_file *a);
 
+/// Copy a file byte for byte, atomically (cal_atomic_file); nothing to do
+/// when both names are the same file. 0, else 1 with a message.
+int cal_copy_file(const char *from, const char *to, char *err, size_t err_len);
+
 /// Remove the temporaries in @p dir left by writers on this host that died
 /// before committing (a SIGKILL between open and rename). Temporaries of live
 /// processes, and of other hosts sharing the folder, are left alone.

@@ -48,4 +48,9 @@ echo "resume: ${before} of ${total} records were stored before it; it ran ${ran}
 changed=$(find "$work/killed/store" -name '*.yaml' ! -newer "$stamp" | wc -l)
 [ "$changed" -ge "$before" ] || { echo "stored records were rewritten"; exit 1; }
 [ -n "$(find "$work/killed" -name '*.tmp')" ] && { echo "a temporary file was left behind: $(find "$work/killed" -name '*.tmp')"; exit 1; } || true
-echo "same table after 5 kills; nothing stored was recomputed"
+# The inputs it read, kept beside its results (what verify_committed.sh re-derives from).
+for f in config.yaml:configs/calibration.yaml repose_angle.csv:experiments/data/repose_angle.csv \
+         occupied_area.csv:experiments/data/occupied_area.csv; do
+  cmp "$work/killed/${f%%:*}" "${f#*:}" || { echo "$work/killed/${f%%:*} is not a copy of ${f#*:}"; exit 1; }
+done
+echo "same table after 5 kills; nothing stored was recomputed; the inputs kept beside it"

@@ -14,7 +14,9 @@
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
 # files, and the data files the run read (repose_angle.csv, occupied_area.csv): for a run made with
 # --data they replace its --data folder, and for one made on the config's own files they are read
-# instead of those (--data), so a later change of the shipped data does not change its table.
+# instead of those (--data), so a later change of the shipped data does not change its table. A
+# config.yaml there (calibrate keeps a copy of the config it read) replaces the command's config
+# the same way.
 set -euo pipefail
 bin=$1 src=$2 results=$3 work=$4 n=${5:-2}
 rm -rf "$work" && mkdir -p "$work/out"
@@ -29,6 +31,7 @@ for ((i = 2; i < ${#words[@]}; ++i)); do # words[0..1]: granucal calibrate
     --data) i=$((i + 1)); args+=(--data "$results") ;;
     --jobs) i=$((i + 1)) ;;
     --stage) stage=${words[i + 1]}; args+=("${words[i]}") ;;
+    *.yaml) if [ -f "$results/config.yaml" ]; then args+=("$results/config.yaml"); else args+=("${words[i]}"); fi ;;
     *) args+=("${words[i]}") ;;
   esac
 done
