@@ -591,8 +591,9 @@ static int write_report(const char *dir, const cal_outcome *o, const sim_tally *
         else
             fprintf(f, "**Unresolved:** the coordination number does not depart from its stiff limit all the way down "
                        "to the softest candidate (%g N/m): some softer candidate is within the tolerance, so what this "
-                       "tier's sweep shows is noise, with no change to stop at; the config's k_n = %g N/m was used. A "
-                       "finer cylinder (smaller cylinder_lambda: more layers, more pressure) resolves it.\n",
+                       "tier's sweep shows is noise, with no change to stop at; the config's k_n = %g N/m was used. "
+                       "Softer candidates may find the change: the coarser the cylinder, the softer its knee (at "
+                       "cylinder λ 32768 the CN rose below 50 N/m, results/stiffness_low_k/).\n",
                     s->k[0], o->config->k_n);
     }
     if (o->granule) report_friction(f, o->granule, &o->config->granule);
