@@ -186,7 +186,8 @@ static double slope(double sxx, double sxd) { return sxx > 0 ? sxd / sxx : 0; }
 // The correction: the discrepancy (run - cheap map) of the runs that measured
 // everything, its mean at their centre and, with three runs or more, its
 // slopes along each direction they span (least squares on the centred
-// coordinates: both at once where both are spanned).
+// coordinates: both at once where both are spanned); with kriging and two
+// runs or more, what that plane leaves at the runs is kriged on top.
 static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const cal_mf_problem *p)
 {
     const int n_y = p->n_y;
