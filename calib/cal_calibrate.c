@@ -295,8 +295,10 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
 {
     *k_n = r->c->k_n, *source = "config k_n (stage 1 not run)";
     if (wants(r, "stiffness")) {
-        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (cylinder λ = %g)\n", r->c->stiffness_count,
-                r->t->seeds, r->t->cylinder_lambda);
+        unsigned n;
+        cal_tier_stiffness(r->c, r->t, &n);
+        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (cylinder λ = %g)\n", n, r->t->seeds,
+                r->t->cylinder_lambda);
         if (cal_stage_stiffness(&r->env, r->c, r->t, &r->stiffness, r->err, sizeof r->err)) return 1;
         if (!isfinite(r->stiffness.chosen_k))
             return exp_fail(r->err, sizeof r->err, "stage 1: no candidate's CN is within the tolerance of the stiff limit");
@@ -423,8 +425,10 @@ static const double predicted_rate = 8.5e6;
 static double cylinders_core_s(const run *r, double *memory_mb)
 {
     double core_s = 0;
-    for (unsigned k = 0; k < r->c->stiffness_count; ++k) {
-        exp_cylinder_def d = cal_cylinder_case_make(r->c, r->t, r->c->stiffness[k], 1);
+    unsigned n;
+    const double *stiffness = cal_tier_stiffness(r->c, r->t, &n);
+    for (unsigned k = 0; k < n; ++k) {
+        exp_cylinder_def d = cal_cylinder_case_make(r->c, r->t, stiffness[k], 1);
         exp_cylinder_cost c = exp_cylinder_predict_cost(&d);
         core_s += r->t->seeds * c.particle_steps / predicted_rate;
         *memory_mb = fmax(*memory_mb, c.memory_mb);
@@ -480,7 +484,9 @@ static void plan_progress(run *r)
 {
     cal_progress *p = &r->progress;
     cal_progress_init(p, r->env.workers * cal_mpi_size());
-    if (wants(r, "stiffness")) cal_progress_plan(p, "stiffness", CAL_RUN_CYLINDER, (int)r->c->stiffness_count * r->t->seeds);
+    unsigned n_k;
+    cal_tier_stiffness(r->c, r->t, &n_k);
+    if (wants(r, "stiffness")) cal_progress_plan(p, "stiffness", CAL_RUN_CYLINDER, (int)n_k * r->t->seeds);
     if (wants(r, "granule")) plan_friction(r, "granule", NULL);
     for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
         const cal_material *m = &r->c->materials[k];

@@ -43,6 +43,7 @@ static const cyaml_schema_field_t tier_fields[] = {
                          &float_entry, 1, 32),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
     TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
+    CYAML_FIELD_SEQUENCE("stiffness", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, stiffness, &float_entry, 2, 64),
     CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
     CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
     CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
@@ -229,6 +230,17 @@ static int check_average_per_rpm(const cal_config *c, const cal_tier *t, int fro
     return 0;
 }
 
+// Stage 1's candidates (the config's, or a tier's from its line on): each > 0, increasing.
+static int check_stiffness(const cal_config *c, int from, const double *k, unsigned n, char *err, size_t len)
+{
+    for (unsigned i = 0; i < n; ++i) {
+        if (bad_positive(k[i])) return located(c, from, "stiffness", err, len, "%g must be > 0", k[i]);
+        if (i && !(k[i] > k[i - 1]))
+            return located(c, from, "stiffness", err, len, "candidates must increase (%g after %g)", k[i], k[i - 1]);
+    }
+    return 0;
+}
+
 static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
@@ -238,6 +250,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return 1;
     if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
+    if (check_stiffness(c, from, t->stiffness, t->stiffness_count, err, len)) return 1;
     if (t->seeds < 1 || t->seeds > 64) return located(c, from, "seeds", err, len, "%d must be in [1, 64]", t->seeds);
     if (t->grid < 0 || t->grid > 16) return located(c, from, "grid", err, len, "%d must be in [0, 16]", t->grid);
     if (t->beds < 0 || t->beds > 16) return located(c, from, "beds", err, len, "%d must be in [1, 16]", t->beds);
@@ -269,6 +282,11 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
 int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
+const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n)
+{
+    *n = t->stiffness_count ? t->stiffness_count : c->stiffness_count;
+    return t->stiffness_count ? t->stiffness : c->stiffness;
+}
 cal_mf_correction_kind cal_tier_map_correction(const cal_tier *t)
 {
     return t->map_correction ? (cal_mf_correction_kind)*t->map_correction : CAL_MF_KRIGING;
@@ -347,12 +365,7 @@ static int validate(const cal_config *c, char *err, size_t len)
     if (!(c->pour_mu_r >= 0 && c->pour_mu_r <= 10)) return located(c, 1, "pour_mu_r", err, len, "%g must be in [0, 10]", c->pour_mu_r);
     if (!(isfinite(c->stiffness_tolerance) && c->stiffness_tolerance >= 0))
         return located(c, 1, "stiffness_tolerance", err, len, "%g must be >= 0 and finite", c->stiffness_tolerance);
-    for (unsigned k = 0; k < c->stiffness_count; ++k) {
-        if (bad_positive(c->stiffness[k])) return located(c, 1, "stiffness", err, len, "%g must be > 0", c->stiffness[k]);
-        if (k && !(c->stiffness[k] > c->stiffness[k - 1]))
-            return located(c, 1, "stiffness", err, len, "candidates must increase (%g after %g)", c->stiffness[k],
-                           c->stiffness[k - 1]);
-    }
+    if (check_stiffness(c, 1, c->stiffness, c->stiffness_count, err, len)) return 1;
     if (check_names(c, err, len) || check_bounds(c, &c->granule, "granule", err, len) ||
         check_bounds(c, &c->wall, "wall", err, len))
         return 1;

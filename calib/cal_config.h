@@ -42,6 +42,11 @@ typedef struct cal_tier {
     double *rpm;            ///< speeds simulated; empty = every speed in the data
     unsigned rpm_count;
     double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
+    /// Stage 1's candidates for this tier (N/m, increasing); absent: the
+    /// config's `stiffness`. A coarser cylinder shows its CN change at softer
+    /// k (results/stiffness_low_k/), so a tier may need softer candidates.
+    double *stiffness;
+    unsigned stiffness_count;
     int seeds;              ///< poured cylinders per stiffness (seed-to-seed spread)
     int grid;               ///< initial design: grid points per axis of (μs, log μr)
     int max_evaluations;    ///< NLopt evaluations after the grid
@@ -149,6 +154,8 @@ void cal_config_free(cal_config *c);
 const cal_tier *cal_config_tier(const cal_config *c);
 /// The tier named `name`, NULL if none.
 const cal_tier *cal_config_tier_named(const cal_config *c, const char *name);
+/// Stage 1's candidates at tier t: the tier's `stiffness`, else the config's.
+const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n);
 
 /// A data path resolved against the config file's directory.
 void cal_config_data_path(const cal_config *c, const char *rel, char *out, size_t len);

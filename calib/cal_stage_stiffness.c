@@ -68,16 +68,18 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
 {
     memset(out, 0, sizeof *out);
     double t0 = exp_wall_seconds();
-    int seeds = t->seeds, n = (int)c->stiffness_count;
+    unsigned n_k;
+    const double *stiffness = cal_tier_stiffness(c, t, &n_k);
+    int seeds = t->seeds, n = (int)n_k;
     if (n > CAL_MAX_K) return exp_fail(err, len, "at most %d stiffness candidates", CAL_MAX_K);
     exp_cylinder_def *cases = calloc((size_t)(n * seeds), sizeof *cases);
     cal_record *rec = calloc((size_t)(n * seeds), sizeof *rec);
     if (!cases || !rec) return free(cases), free(rec), exp_fail(err, len, "out of memory");
     out->n = n;
     for (int i = 0; i < n; ++i) {
-        out->k[i] = c->stiffness[i];
+        out->k[i] = stiffness[i];
         for (int j = 0; j < seeds; ++j)
-            cases[i * seeds + j] = cal_cylinder_case_make(c, t, c->stiffness[i], (uint64_t)(c->seed + j));
+            cases[i * seeds + j] = cal_cylinder_case_make(c, t, stiffness[i], (uint64_t)(c->seed + j));
     }
     cal_env_set_stage(env, "stiffness");
     cal_progress_enter(env->progress, env->stage);

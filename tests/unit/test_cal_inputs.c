@@ -240,6 +240,7 @@ static void test_bad_config_named_by_line_and_field(void **state)
     expect_config_error("map_tier: ci", "map_tier: quick", "map_tier");     // other speeds
     expect_config_error("    map_tier: ci\n", "    map_tier: ci\n    map_correction: spline\n", "map_correction"); // not a kind
     expect_config_error("  - name: ci\n", "  - name: ci\n    map_correction: kriging\n", "map_correction"); // no map
+    expect_config_error("    stiffness: [5, 10, 20", "    stiffness: [5, 20, 10", "stiffness"); // a tier's, not increasing
     expect_config_error("beds: 2", "beds: 40", "beds");
     // average_time_per_rpm (the ci tier: rpm [4, 40, 116], max_time 4, window 1; standard: average_time)
     expect_config_error("beds: 2", "beds: 2\n    average_time_per_rpm: [1.0, 1.0]", "average_time_per_rpm");
