@@ -427,13 +427,6 @@ static const cyaml_schema_value_t compress_schema = {
 
 int exp_is_compress_config(const char *path) { return exp_yaml_starts_with(path, "experiment: compression"); }
 
-static int located(const char *path, const char *field, char *err, size_t len, const char *msg)
-{
-    int line = exp_yaml_line_of(path, field, 1);
-    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
-    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
-}
-
 static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t len)
 {
     *d = exp_default_compress_def();
@@ -468,13 +461,13 @@ static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp
     char msg[300];
     int bad = 0;
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
-    if (!bad && strcmp(y->experiment, "compression") != 0) bad = located(path, "experiment", err, len, "must be compression");
+    if (!bad && strcmp(y->experiment, "compression") != 0) bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
         // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
-        char field[48];
-        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
-        const char *leaf = strrchr(field, '.');
-        bad = located(path, leaf ? leaf + 1 : field, err, len, msg);
+        // Blamed on the file's line even when a --set gave the value (as before;
+        // the drum and the cylinder blame the --set).
+        char field[EXP_FIELD_LEN];
+        bad = exp_field_error(path, 0, NULL, exp_message_field(msg, field), msg, err, len);
     }
     if (bad) {
         exp_yaml_free(&compress_schema, y);

@@ -108,10 +108,8 @@ int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_de
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_cylinder_check(d, msg, sizeof msg))) {
         // Messages start with the field: "depth = ...", "granule_contact.mu_s = ...",
         // "gsd.geometric_sd = ..."; the YAML key is the last part.
-        char field[48];
-        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
-        const char *leaf = strrchr(field, '.');
-        bad = exp_field_error(path, n_sets, sets, leaf ? leaf + 1 : field, msg, err, len);
+        char field[EXP_FIELD_LEN];
+        bad = exp_field_error(path, n_sets, sets, exp_message_field(msg, field), msg, err, len);
     }
     exp_yaml_free(&cylinder_schema, y);
     return bad;

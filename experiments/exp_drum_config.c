@@ -171,10 +171,8 @@ static int validate(const source *from, const exp_drum_yaml *y, char *err, size_
     exp_drum_run_opts run;
     char msg[300];
     if (exp_drum_config_defs(y, &def, &run, msg, sizeof msg) || exp_drum_check(&def, msg, sizeof msg)) {
-        char field[48];
-        snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
-        const char *leaf = strrchr(field, '.');
-        return located(from, leaf ? leaf + 1 : field, err, len, "%s", msg);
+        char field[EXP_FIELD_LEN];
+        return located(from, exp_message_field(msg, field), err, len, "%s", msg);
     }
     return 0;
 }

@@ -131,17 +131,19 @@ int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, co
     return 0;
 }
 
+const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN])
+{
+    size_t n = strcspn(msg, " =:");
+    snprintf(field, EXP_FIELD_LEN, "%.*s", (int)(n < EXP_FIELD_LEN ? n : EXP_FIELD_LEN - 1), msg);
+    const char *leaf = strrchr(field, '.');
+    return leaf ? leaf + 1 : field;
+}
+
 // Point a message at the line of its field: "path:line: field...: why".
-// Messages from the checks start with the field path ("walls[0].contact.mu_s
-// = -1: ..."); its last component is looked up in the file.
 static int located(const char *path, const char *msg, char *err, size_t len)
 {
-    char field[64];
-    size_t n = strcspn(msg, " =:");
-    snprintf(field, sizeof field, "%.*s", (int)(n < sizeof field ? n : sizeof field - 1), msg);
-    const char *leaf = strrchr(field, '.');
-    leaf = leaf ? leaf + 1 : field;
-    int line = exp_yaml_line_of(path, leaf, 1);
+    char field[EXP_FIELD_LEN];
+    int line = exp_yaml_line_of(path, exp_message_field(msg, field), 1);
     if (line > 0) return exp_fail(err, len, "%s:%d: %s", path, line, msg);
     return exp_fail(err, len, "%s: %s", path, msg);
 }

@@ -64,6 +64,12 @@ int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, co
 /// YAML library reports only the field.
 int exp_yaml_line_of(const char *path, const char *key, int from_line);
 
+/// The field a check's message starts with ("granule_contact.mu_s = -1: ...",
+/// "walls[0].contact.mu_s = ..."): its whole path into `field`, and, returned,
+/// its last component (a pointer into `field`), the key to look up in the file.
+enum { EXP_FIELD_LEN = 64 };
+const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN]);
+
 /// The error for a config field whose value is bad, pointed at where the value
 /// came from: "PATH: --set FIELD=V: MSG" when the last `--set` of that field
 /// (among sets[0..n_sets)) gave it, else "PATH:LINE: FIELD: MSG" at the field's

@@ -406,10 +406,8 @@ static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_sil
     if (!bad) {
         to_def(y, d);
         if (exp_silo_check(d, msg, sizeof msg)) {
-            char field[48];
-            snprintf(field, sizeof field, "%.*s", (int)strcspn(msg, " =:"), msg);
-            const char *leaf = strrchr(field, '.');
-            leaf = leaf ? leaf + 1 : field;
+            char field[EXP_FIELD_LEN];
+            const char *leaf = exp_message_field(msg, field);
             // granule_contact.k_n: the YAML key is k_n, wall_contact.k_n is wall_k_n.
             char key[64];
             snprintf(key, sizeof key, "%s%s", strncmp(field, "wall_contact", 12) == 0 ? "wall_" : "", leaf);
