@@ -464,10 +464,8 @@ static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp
     if (!bad && strcmp(y->experiment, "compression") != 0) bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
         // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
-        // Blamed on the file's line even when a --set gave the value (as before;
-        // the drum and the cylinder blame the --set).
         char field[EXP_FIELD_LEN];
-        bad = exp_field_error(path, 0, NULL, exp_message_field(msg, field), msg, err, len);
+        bad = exp_field_error(path, n_sets, sets, exp_message_field(msg, field), msg, err, len);
     }
     if (bad) {
         exp_yaml_free(&compress_schema, y);

@@ -165,6 +165,11 @@ static void test_bad_input_is_named(void **state)
     char *set = "mu_r=0.1";
     assert_int_not_equal(exp_compress_load(path, 1, &set, &d, err, sizeof err), 0);
     assert_non_null(strstr(err, "rolling"));
+    // A bad value given by --set is blamed on the --set, not on the file's line.
+    set = "sigma_max=5";
+    assert_int_not_equal(exp_compress_load(path, 1, &set, &d, err, sizeof err), 0);
+    printf("%s\n", err);
+    assert_non_null(strstr(err, "--set sigma_max=5"));
     remove(tmp);
 }
 
