@@ -241,12 +241,17 @@ static int measure_rung(study *s, rung_result *out)
     int n_ok[MAX_SPEEDS] = {0};
     out->granules = out->particle_steps = out->wall_s = out->peak_rss_mb = 0;
     out->runs = 0;
-    for (int seed = 0; seed < f->seeds; ++seed) {
-        cal_drum_case d = case_of(s, out->rung, seed);
-        cal_record rec[MAX_SPEEDS];
-        if (cal_drum_evaluate(&s->env, &d, f->rpm, (int)f->rpm_count, rec, s->err, sizeof s->err)) return 1;
-        for (unsigned k = 0; k < f->rpm_count; ++k) {
-            const cal_record *r = &rec[k];
+    // Every seed's speeds at once: their missing runs share the workers, so a
+    // rung with one run left per seed does not leave the others idle.
+    cal_drum_case cases[MAX_SEEDS];
+    for (int seed = 0; seed < f->seeds; ++seed) cases[seed] = case_of(s, out->rung, seed);
+    const int n_rpm = (int)f->rpm_count;
+    cal_record *rec = calloc((size_t)f->seeds * (size_t)n_rpm, sizeof *rec);
+    if (!rec) return exp_fail(s->err, sizeof s->err, "out of memory");
+    if (cal_drum_evaluate_many(&s->env, cases, f->seeds, f->rpm, n_rpm, rec, s->err, sizeof s->err)) return free(rec), 1;
+    for (int seed = 0; seed < f->seeds; ++seed)
+        for (int k = 0; k < n_rpm; ++k) {
+            cal_record *r = &rec[seed * n_rpm + k];
             out->wall_s += cal_record_cost_s(r);
             out->runs++;
             out->particle_steps += r->particle_steps;
@@ -257,9 +262,9 @@ static int measure_rung(study *s, rung_result *out)
                 out->steady[k] += r->steady;
                 out->granules += r->granules, out->dt_s = r->dt_s;
             }
-            cal_record_free(&rec[k]);
+            cal_record_free(r);
         }
-    }
+    free(rec);
     int usable = 0;
     for (unsigned k = 0; k < f->rpm_count; ++k) {
         out->usable[k] = n_ok[k], usable += n_ok[k];
