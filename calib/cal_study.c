@@ -423,6 +423,30 @@ static void write_convergence(FILE *o, const study *s)
     else fputs("**No coarser λ was run beside it: its convergence is not shown.**\n", o);
 }
 
+// Every speed of every rung run: the angle ± the standard error of its seed
+// mean, and the CSA ± its seed sd (the first table shows the first speed only).
+static void write_speeds_table(FILE *o, const study *s)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    fputs("\nEvery speed, angle (°) ± SE / CSA (%) ± seed sd:\n\n| rung |", o);
+    for (unsigned k = 0; k < f->rpm_count; ++k) fprintf(o, " %g rpm |", f->rpm[k]);
+    fputs("\n|---|", o);
+    for (unsigned k = 0; k < f->rpm_count; ++k) fputs("---|", o);
+    fputc('\n', o);
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        fprintf(o, "| %s |", r->rung->name);
+        for (unsigned k = 0; k < f->rpm_count; ++k) {
+            char angle[48], csa[48];
+            with_spread(angle, sizeof angle, r->angle[k], r->angle_se[k]);
+            with_spread(csa, sizeof csa, r->csa[k], r->csa_sd[k]);
+            fprintf(o, " %s / %s |", angle, csa);
+        }
+        fputc('\n', o);
+    }
+}
+
 static int write_markdown(const study *s, const char *command, double wall, char *err, size_t len)
 {
     const cal_fidelity *f = s->c->fidelity;
@@ -468,6 +492,7 @@ static int write_markdown(const study *s, const char *command, double wall, char
                 r->peak_rss_mb);
     }
     write_convergence(o, s);
+    if (f->rpm_count > 1) write_speeds_table(o, s);
     fputs("\nThe paper's Table B.1 (aluminium drum, calibrated model; its rpm is not stated), beside the rungs:\n\n"
           "| λ | angle (°) | CSA (%) |\n|---|---|---|\n",
           o);
@@ -477,9 +502,9 @@ static int write_markdown(const study *s, const char *command, double wall, char
         if (s->res[i].ran)
             fprintf(o, "| %g (%s, %g rpm) | %.2f | %.2f |\n", s->res[i].rung->lambda, s->res[i].rung->name, f->rpm[0],
                     s->res[i].angle[0], s->res[i].csa[0]);
-    fputs("\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
-          "`fidelity_vs_lambda.png`.\n",
-          o);
+    fprintf(o, "\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
+               "`fidelity_vs_lambda.png`%s.\n",
+            f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
     return cal_atomic_commit(&a, err, len);
 }
 
@@ -553,12 +578,47 @@ static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_
     return exp_plot_png(path, &axes, 4, v, 1000, 640, err, len);
 }
 
+// Each rung's angle and CSA against the drum's speed (a study of several
+// speeds): where the rungs part, speed by speed. One colour a rung; the angle
+// solid with circles, the CSA dashed with squares; bars: the seed sd.
+static int plot_vs_rpm(const study *s, char *err, size_t len)
+{
+    static const double palette[][3] = {{0.84, 0.15, 0.16}, {0.12, 0.40, 0.75}, {0.17, 0.63, 0.17},
+                                        {0.58, 0.40, 0.74}, {1.00, 0.50, 0.05}, {0.55, 0.34, 0.29},
+                                        {0.89, 0.47, 0.76}, {0.50, 0.50, 0.50}};
+    enum { MAX_PLOTTED = sizeof palette / sizeof *palette };
+    const cal_fidelity *f = s->c->fidelity;
+    exp_plot_series v[2 * MAX_PLOTTED];
+    char label[MAX_PLOTTED][96];
+    size_t n = 0;
+    for (int i = 0; i < s->n && n < 2 * MAX_PLOTTED; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        const size_t c = n / 2;
+        const double *rgb = palette[c];
+        snprintf(label[c], sizeof label[0], "%s: angle (solid), CSA (dashed)", r->rung->name);
+        v[n] = (exp_plot_series){.n = f->rpm_count, .x = f->rpm, .y = r->angle, .err = r->angle_sd,
+                                 .label = label[c], .rgb = {rgb[0], rgb[1], rgb[2]},
+                                 .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_CIRCLE};
+        v[n + 1] = (exp_plot_series){.n = f->rpm_count, .x = f->rpm, .y = r->csa, .err = r->csa_sd,
+                                     .rgb = {rgb[0], rgb[1], rgb[2]}, .dashed = 1,
+                                     .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_SQUARE};
+        n += 2;
+    }
+    char path[1200];
+    snprintf(path, sizeof path, "%s/fidelity_vs_rpm.png", s->report);
+    exp_plot_axes axes = {.title = "Angle and CSA against the drum's speed, each rung (bars: seed sd)",
+                          .xlabel = "drum speed (rpm)", .ylabel = "angle (°) / CSA (%)"};
+    return exp_plot_png(path, &axes, n, v, 1000, 640, err, len);
+}
+
 static int write_plots(const study *s, char *err, size_t len)
 {
     rung_points p;
     collect_rungs(s, &p);
     if (p.n > 0 && plot_error_vs_cost(s, &p, err, len)) return 1;
-    return p.m > 0 && plot_vs_lambda(s, &p, err, len);
+    if (p.m > 0 && plot_vs_lambda(s, &p, err, len)) return 1;
+    return p.m > 0 && s->c->fidelity->rpm_count > 1 && plot_vs_rpm(s, err, len);
 }
 
 // Run each wanted rung that fits the budget, in config order.

@@ -63,4 +63,13 @@ before=$(md5sum < "$work/ladder/fidelity.md")
 [ "$(md5sum < "$work/ladder/fidelity.md")" = "$before" ] || { echo "--report overwrote the ladder's fidelity.md"; exit 1; }
 grep -q "The finest rung run is L512-slice8-avg8" "$work/ladder/one_rung/fidelity.md" || { echo "--report wrote no report"; exit 1; }
 [ -e "$work/ladder/one_rung/store" ] && { echo "--report made a second store"; exit 1; }
-echo "fidelity study: 2 rungs run, 1 predicted, rerun from the store; the committed ladder read as still moving; --report beside it"
+# Several speeds, read back from the committed ladder: every seed's speeds are fetched together, and each
+# record must land on its own speed (the values the one-seed-at-a-time study wrote in
+# results/fidelity_ladder/fast_speeds_L1000/fidelity.csv); a per-speed table and a plot against the speed.
+"$bin" study fidelity configs/calibration.yaml --out "$work/ladder" --report "$work/ladder/speeds" --jobs 2 \
+  --budget-hours 100 --rpm 40,80,105,116 --rungs L1000-slice9-avg2 > "$work/speeds.log" 2>&1 || { cat "$work/speeds.log"; exit 1; }
+if grep -q "simulated in" "$work/speeds.log"; then echo "the committed fast speeds were simulated again"; exit 1; fi
+grep -q "| L1000-slice9-avg2 | 43.21 ± 0.14 / 48.45 ± 0.01 | 51.95 ± 0.07 / 51.47 ± 0.01 | 49.81 ± 0.18 / 57.87 ± 0.22 | 34.63 ± 0.29 / 64.56 ± 0.45 |" \
+  "$work/ladder/speeds/fidelity.md" || { echo "the per-speed table is not the committed ladder's:"; grep -A4 "Every speed" "$work/ladder/speeds/fidelity.md"; exit 1; }
+[ -s "$work/ladder/speeds/fidelity_vs_rpm.png" ] || { echo "no plot against the speed"; exit 1; }
+echo "fidelity study: 2 rungs run, 1 predicted, rerun from the store; the committed ladder read as still moving; --report beside it; the fast speeds read back speed by speed"
