@@ -49,7 +49,7 @@ static void predictions_within_a_fraction_of_records(void **state)
     }
 }
 
-// The standard tier's stage 1 (results/calibration-standard/store): poured
+// The standard tier's stage 1 (results/calibration-standard-affine/store): poured
 // cylinders at λ 32768, seed 1 of each stiffness (the other seeds lie within
 // 3 % in granules and step).
 typedef struct measured_cylinder {

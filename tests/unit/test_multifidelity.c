@@ -195,7 +195,7 @@ static void a_bias_along_mu_r_is_fitted(void **state)
 }
 
 // A discrepancy that curves along v (log μr) with μs on its bound, as in the
-// standard calibration's granule stage (results/calibration-standard/): the
+// standard calibration's granule stage (results/calibration-standard-affine/): the
 // λ 1000 angle rose 5.1° from μr 0.011 to 0.13 and 6.7° from there to 0.35,
 // far more steeply than the ci map. Here the expensive angle is 20 + 4u + 22v²,
 // the cheap map's 26 + 4u + 8v; one CSA rises with u only and its target lies
