@@ -6,7 +6,9 @@
 // if asked, turn the bed as a calibration does (exp_drum_rotate, Table 3's
 // pair) and report the angle, the CSA, the turn's particle-steps per second
 // with and without its measuring, and the whole run's against the kernel's.
-//   usage: bench_drum_phases LAMBDA SLICE_DEPTH_M pour|pack SEED [RPM MAX_TIME_S]
+// K_N (N/m, default Table 3's 200) is the granule stiffness, the boundaries
+// twice it (Table 3): what a stiffness chosen by stage 1 costs in steps.
+//   usage: bench_drum_phases LAMBDA SLICE_DEPTH_M pour|pack SEED [RPM MAX_TIME_S [K_N]]
 // One line of key=value pairs on stdout (tests/bench/drum_fill_methods.sh and
 // drum_end_to_end.sh collect them).
 #include <stdio.h>
@@ -14,6 +16,7 @@
 #include <string.h>
 
 #include "exp_common.h"
+#include "exp_contact_rules.h"
 #include "exp_drum.h"
 
 // The fill's phases as its progress reports them, every 0.01 s simulated:
@@ -59,10 +62,14 @@ static double kernel_rate(const dem_world *bed)
 
 int main(int argc, char **argv)
 {
-    if (argc != 5 && argc != 7)
-        return fprintf(stderr, "usage: %s LAMBDA SLICE_DEPTH_M pour|pack SEED [RPM MAX_TIME_S]\n", argv[0]), 2;
+    if (argc != 5 && argc != 7 && argc != 8)
+        return fprintf(stderr, "usage: %s LAMBDA SLICE_DEPTH_M pour|pack SEED [RPM MAX_TIME_S [K_N]]\n", argv[0]), 2;
     exp_drum_def d = exp_default_drum_def();
     d.lambda = atof(argv[1]), d.periodic = 1, d.depth = atof(argv[2]), d.seed = strtoull(argv[4], NULL, 10);
+    if (argc == 8) {
+        d.granule = exp_granule_pair(atof(argv[7]), d.granule.xi, d.granule.mu_s, d.granule.mu_r, d.granule.damping);
+        d.wall = d.end_plate = exp_boundary_pair(&d.granule, d.granule.mu_s, d.granule.mu_r);
+    }
     if (exp_drum_fill_method_from_name(argv[3], &d.fill_method)) return fprintf(stderr, "pour or pack\n"), 2;
     char err[1024];
     phase_clock clock = {.last_wall = exp_wall_seconds()};
@@ -73,12 +80,12 @@ int main(int argc, char **argv)
     dem_diagnostics diag = dem_world_diagnose(w);
     size_t n = dem_world_granules(w).count;
     double fill_steps = clock.granule_seconds / dem_world_dt(w), kernel = kernel_rate(w);
-    printf("fill_method=%s lambda=%g slice_m=%g seed=%s granules=%zu fill_sim_s=%.3f fill_wall_s=%.2f "
+    printf("fill_method=%s lambda=%g slice_m=%g k_n=%g seed=%s granules=%zu fill_sim_s=%.3f fill_wall_s=%.2f "
            "pour_wall_s=%.2f settle_wall_s=%.2f fill_dt_s=%.4g fill_particle_steps_per_s=%.4g solid_fraction=%.4f "
            "coordination=%.3f kernel_particle_steps_per_s=%.4g",
-           argv[3], d.lambda, d.depth, argv[4], n, dem_world_time(w), fill_wall, clock.pour_s, clock.settle_s,
+           argv[3], d.lambda, d.depth, d.granule.k_n, argv[4], n, dem_world_time(w), fill_wall, clock.pour_s, clock.settle_s,
            dem_world_dt(w), fill_steps / fill_wall, bed_solid_fraction(w, &d), diag.coordination, kernel);
-    if (argc == 7) {
+    if (argc >= 7) {
         exp_drum_run_opts o = exp_default_drum_run_opts();
         o.rpm = atof(argv[5]), o.max_time = atof(argv[6]);
         exp_drum_result r;
