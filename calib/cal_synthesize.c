@@ -166,6 +166,7 @@ typedef struct job {
     cal_config *c;
     const cal_tier *t;
     cal_env env;
+    cal_progress progress; ///< one stage a lining: its runs done and the time left, on each run's line
     double k_n, gg_mu_s, gg_mu_r;
     double rpm[CAL_MAX_RPM], angle_rpm;
     int n_rpm;
@@ -286,6 +287,7 @@ static int make_lining(job *j, const lining *l, lining_result *out)
     for (int s = 0; s < n; ++s) cases[s] = case_of(j, l, j->opt.seeds[s]);
     if (j->opt.reuse && reuse_records(j, cases, n)) return free(rec), 1;
     cal_env_set_stage(&j->env, l->surface);
+    cal_progress_enter(&j->progress, l->surface);
     if (cal_drum_evaluate_many(&j->env, cases, n, j->rpm, j->n_rpm, rec, j->err, sizeof j->err)) return free(rec), 1;
     int bad = 0;
     for (int k = 0; k < j->n_rpm; ++k) {
@@ -365,6 +367,16 @@ static int prepare(job *j)
     return 0;
 }
 
+// Each lining a stage of seeds × speeds drum runs (those reused or stored
+// count as done, and their recorded cost sets the time left from the start).
+static void plan_progress(job *j)
+{
+    cal_progress_init(&j->progress, j->env.workers * cal_mpi_size());
+    for (int l = 0; l < j->n_linings; ++l)
+        cal_progress_plan(&j->progress, j->linings[l].surface, CAL_RUN_DRUM, j->opt.n_seeds * j->n_rpm);
+    j->env.progress = &j->progress;
+}
+
 int cal_cmd_synthesize(int argc, char **argv)
 {
     job *j = calloc(1, sizeof *j);
@@ -379,6 +391,7 @@ int cal_cmd_synthesize(int argc, char **argv)
 #endif
     lining_result res[MAX_WALLS + 1];
     status = prepare(j);
+    if (!status) plan_progress(j);
     for (int l = 0; l < j->n_linings && !status; ++l) {
         fprintf(stderr, "== %s: %d seed(s) x %d speed(s)\n", j->linings[l].surface, j->opt.n_seeds, j->n_rpm);
         status = make_lining(j, &j->linings[l], &res[l]);
