@@ -234,6 +234,39 @@ static void checkpoint_path(const cal_env *env, const char *key, char *out, size
     snprintf(out, len, "%s/%s.turn.h5", env->store, hash);
 }
 
+// A line now and then from a simulation still running (a fine drum's fill
+// or turn takes up to an hour), so a log shows it is alive and how far it is.
+enum { HEARTBEAT_EVERY_S = 600 };
+typedef struct heartbeat {
+    const char *stage;
+    char what[48]; ///< "4 rpm", "bed of seed 2"
+    double started, last;
+} heartbeat;
+
+static heartbeat heartbeat_start(const char *stage)
+{
+    heartbeat h = {.stage = stage, .started = exp_wall_seconds()};
+    h.last = h.started;
+    return h;
+}
+
+static heartbeat heartbeat_of_bed(const char *stage, const exp_drum_def *fill)
+{
+    heartbeat h = heartbeat_start(stage);
+    snprintf(h.what, sizeof h.what, "the bed of seed %llu", (unsigned long long)fill->seed);
+    return h;
+}
+
+static void show_heartbeat(const char *phase, double t, size_t granules, void *ctx)
+{
+    heartbeat *h = ctx;
+    double now = exp_wall_seconds();
+    if (now - h->last < HEARTBEAT_EVERY_S) return;
+    h->last = now;
+    fprintf(stderr, "[%s] %s: still running, %s at %.2f s simulated, %zu granules, %.0f min so far\n", h->stage, h->what,
+            phase, t, granules, (now - h->started) / 60);
+}
+
 // Turn `bed` at run r's speed and store the record; fill_s: the settling's
 // wall time, charged to this run. The bed itself is turned only when it is
 // this run's alone (a forked child's copy, own = 1); else a clone.
@@ -250,7 +283,9 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     if (ck.every_s > 0) run.checkpoint = &ck;
     double t0 = exp_wall_seconds();
     exp_drum_result res;
-    dem_status st = exp_drum_rotate(w, &c->def, &run, NULL, NULL, &res);
+    heartbeat h = heartbeat_start(b->env->stage);
+    snprintf(h.what, sizeof h.what, "%g rpm", run.rpm);
+    dem_status st = exp_drum_rotate(w, &c->def, &run, show_heartbeat, &h, &res);
     if (res.checkpoint_note[0]) fprintf(stderr, "[%s] %s\n", b->env->stage, res.checkpoint_note);
     if (res.resumed)
         fprintf(stderr, "[%s] %g rpm: resumed from its checkpoint (%.0f s of wall time saved)\n", b->env->stage,
@@ -289,7 +324,8 @@ static int settle_and_turn(int i, void *ctx)
     int c = b->case_todo[i], bad = 0;
     char err[1024];
     double t0 = exp_wall_seconds();
-    dem_world *bed = exp_drum_fill(&b->cases[c].fill, NULL, NULL, err, sizeof err);
+    heartbeat h = heartbeat_of_bed(b->env->stage, &b->cases[c].fill);
+    dem_world *bed = exp_drum_fill(&b->cases[c].fill, show_heartbeat, &h, err, sizeof err);
     double fill_s = exp_wall_seconds() - t0;
     for (int j = 0; j < b->n_todo; ++j) {
         if (b->todo[j].c != c) continue;
@@ -369,7 +405,8 @@ static dem_world *settled_bed(cal_env *env, const exp_drum_def *fill, double *wa
     if (env->kept_bed && strcmp(text, env->kept_text) == 0) return env->kept_bed;
     cal_sim_release(env);
     double t0 = exp_wall_seconds();
-    env->kept_bed = exp_drum_fill(fill, NULL, NULL, err, len);
+    heartbeat h = heartbeat_of_bed(env->stage, fill);
+    env->kept_bed = exp_drum_fill(fill, show_heartbeat, &h, err, len);
     *wall_s = exp_wall_seconds() - t0;
     if (env->kept_bed) snprintf(env->kept_text, sizeof env->kept_text, "%s", text);
     return env->kept_bed;
