@@ -239,7 +239,7 @@ static void checkpoint_path(const cal_env *env, const char *key, char *out, size
 enum { HEARTBEAT_EVERY_S = 600 };
 typedef struct heartbeat {
     const char *stage;
-    char what[48]; ///< "4 rpm", "bed of seed 2"
+    char what[48]; ///< "4 rpm, seed 2", "the bed of seed 2"
     double started, last;
 } heartbeat;
 
@@ -284,7 +284,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     double t0 = exp_wall_seconds();
     exp_drum_result res;
     heartbeat h = heartbeat_start(b->env->stage);
-    snprintf(h.what, sizeof h.what, "%g rpm", run.rpm);
+    snprintf(h.what, sizeof h.what, "%g rpm, seed %llu", run.rpm, (unsigned long long)c->def.seed);
     dem_status st = exp_drum_rotate(w, &c->def, &run, show_heartbeat, &h, &res);
     if (res.checkpoint_note[0]) fprintf(stderr, "[%s] %s\n", b->env->stage, res.checkpoint_note);
     if (res.resumed)
