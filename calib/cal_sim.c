@@ -267,10 +267,23 @@ static void show_heartbeat(const char *phase, double t, size_t granules, void *c
             phase, t, granules, (now - h->started) / 60);
 }
 
+// A run stored by a task that goes on turning the same bed at other speeds:
+// said at once, since the task's own line (with the progress) comes only when
+// the bed's last speed is done.
+static void announce_stored(const cal_env *env, const char *what, const cal_record *r, int speeds_left)
+{
+    fprintf(stderr, "[%s] %s: %s, angle %.1f° ± %.1f, CSA %.1f %% ± %.1f — %.2f s simulated in %.0f s; stored, %d more "
+                    "speed(s) on this bed\n",
+            env->stage, what, r->status, r->angle_deg, r->angle_sd_deg, r->csa_percent, r->csa_sd_percent,
+            r->simulated_time_s, r->wall_time_s, speeds_left);
+}
+
 // Turn `bed` at run r's speed and store the record; fill_s: the settling's
 // wall time, charged to this run. The bed itself is turned only when it is
 // this run's alone (a forked child's copy, own = 1); else a clone.
-static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill_s, int own)
+// speeds_left > 0: the caller turns this bed at that many more speeds (the
+// run is announced when stored).
+static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill_s, int own, int speeds_left)
 {
     const cal_drum_case *c = &b->cases[r.c];
     const char *key = run_key(b, r);
@@ -305,6 +318,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     int bad = cal_store_put(b->env->store, &rec, err, sizeof err);
     if (bad) fprintf(stderr, "granucal calibrate: %s\n", err);
     else dem_checkpoint_remove(ck_path); // the record holds the result now
+    if (!bad && speeds_left > 0) announce_stored(b->env, h.what, &rec, speeds_left);
     if (!own) dem_world_destroy(w);
     return bad;
 }
@@ -313,7 +327,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
 static int turn_one(int i, void *ctx)
 {
     drum_batch *b = ctx;
-    return turn_and_store(b, b->bed, b->todo[i], i == 0 ? b->bed_wall_s : 0, b->env->use_fork);
+    return turn_and_store(b, b->bed, b->todo[i], i == 0 ? b->bed_wall_s : 0, b->env->use_fork, 0);
 }
 
 // Own bed: task i settles candidate case_todo[i]'s bed and turns a copy of it
@@ -327,10 +341,13 @@ static int settle_and_turn(int i, void *ctx)
     heartbeat h = heartbeat_of_bed(b->env->stage, &b->cases[c].fill);
     dem_world *bed = exp_drum_fill(&b->cases[c].fill, show_heartbeat, &h, err, sizeof err);
     double fill_s = exp_wall_seconds() - t0;
+    int left = 0;
+    for (int j = 0; j < b->n_todo; ++j) left += b->todo[j].c == c;
     for (int j = 0; j < b->n_todo; ++j) {
         if (b->todo[j].c != c) continue;
+        --left;
         if (!bed) bad |= write_failed(b->env, run_key(b, b->todo[j]), err);
-        else bad |= turn_and_store(b, bed, b->todo[j], fill_s, 0), fill_s = 0;
+        else bad |= turn_and_store(b, bed, b->todo[j], fill_s, 0, left), fill_s = 0;
     }
     dem_world_destroy(bed);
     return bad;
@@ -363,7 +380,9 @@ static void show_run(drum_batch *b, drum_run r, int code, int n_cases)
 {
     char what[96];
     const dem_contact_params *p = &b->cases[r.c].def.wall; // the granule stage's wall pair is its granule pair
-    if (n_cases > 1) snprintf(what, sizeof what, "mu_s = %.4g, mu_r = %.4g, %g rpm", p->mu_s, p->mu_r, b->rpm[r.k]);
+    if (n_cases > 1) // candidates differ by pair, beds by seed
+        snprintf(what, sizeof what, "mu_s = %.4g, mu_r = %.4g, %g rpm, seed %llu", p->mu_s, p->mu_r, b->rpm[r.k],
+                 (unsigned long long)b->cases[r.c].def.seed);
     else snprintf(what, sizeof what, "%g rpm", b->rpm[r.k]);
     finish_run(b->env, drum_kind(b->env), run_key(b, r), what, code);
 }
