@@ -580,7 +580,8 @@ static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_
 
 // Each rung's angle and CSA against the drum's speed (a study of several
 // speeds): where the rungs part, speed by speed. One colour a rung; the angle
-// solid with circles, the CSA dashed with squares; bars: the seed sd.
+// solid with circles, the CSA dashed with squares; bars: the seed sd. The
+// first 8 rungs run (a colour each): beyond that the plot would not be read.
 static int plot_vs_rpm(const study *s, char *err, size_t len)
 {
     static const double palette[][3] = {{0.84, 0.15, 0.16}, {0.12, 0.40, 0.75}, {0.17, 0.63, 0.17},
