@@ -37,7 +37,7 @@ void exp_print_progress(const char *phase, double t, size_t granules, void *prin
 {
     exp_progress_printer *p = printer;
     double now = exp_wall_seconds();
-    if (now - p->last < 10.0) return;
+    if (now - p->last < (p->every_s > 0 ? p->every_s : 10.0)) return;
     p->last = now;
     fprintf(stderr, "%s: %s t = %.4f s, %zu granules, wall %.0f s\n", p->scene, phase, t, granules, now - p->start);
 }

@@ -23,11 +23,13 @@ const char *exp_results_version(void);
 typedef void (*exp_progress_fn)(const char *phase, double t, size_t granules, void *ctx);
 
 /// A scene's progress printer (an exp_progress_fn's ctx): one line on stderr
-/// at most every 10 s of wall time, "<scene>: <phase> t = ... s, N granules,
-/// wall W s". Start it with {scene, 0, exp_wall_seconds()}.
+/// at most every `every_s` of wall time (0: 10 s), "<scene>: <phase> t = ...
+/// s, N granules, wall W s". Start it with {.scene, .start = exp_wall_seconds()}
+/// (a first line at once), or with last = start to wait a whole interval.
 typedef struct exp_progress_printer {
     const char *scene;
     double last, start;
+    double every_s;
 } exp_progress_printer;
 void exp_print_progress(const char *phase, double t, size_t granules, void *printer);
 

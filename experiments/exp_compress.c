@@ -550,7 +550,7 @@ int exp_compress_simulate(const char *path, int n_sets, char **sets, const char 
         exp_yaml_free(&compress_schema, y);
         return 1;
     }
-    exp_progress_printer p = {"compression", 0, exp_wall_seconds()};
+    exp_progress_printer p = {.scene = "compression", .start = exp_wall_seconds()};
     exp_compress_result r;
     dem_world *w = exp_compress_run(&d, exp_print_progress, &p, &r, err, sizeof err);
     int rc = 1;

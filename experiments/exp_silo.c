@@ -456,7 +456,7 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     exp_yaml_free(&silo_schema, y);
     snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/silo");
     if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    exp_progress_printer ps = {"silo", 0, exp_wall_seconds()};
+    exp_progress_printer ps = {.scene = "silo", .start = exp_wall_seconds()};
     size_t plate = 0;
     dem_world *w = exp_silo_prepare(&d, exp_print_progress, &ps, &plate, err, sizeof err);
     if (!w) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
