@@ -140,9 +140,9 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
              c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
 }
 
-static void show_done(const cal_env *env, const char *what, const cal_record *r)
+// "[stage] what: status (reason), angle ..., CSA ... — T s simulated in W s; ENDING"
+static void show_record(const cal_env *env, const char *what, const cal_record *r, const char *ending)
 {
-    double wall = exp_wall_seconds() - env->started;
     if (env->tty) fputs("\r\033[K", stderr);
     fprintf(stderr, "[%s] %s: %s", env->stage, what, r->status);
     if (r->reason && r->reason[0]) fprintf(stderr, " (%s)", r->reason);
@@ -151,10 +151,17 @@ static void show_done(const cal_env *env, const char *what, const cal_record *r)
     else if (r->granules)
         fprintf(stderr, ", angle %.1f° ± %.1f, CSA %.1f %% ± %.1f", r->angle_deg, r->angle_sd_deg, r->csa_percent,
                 r->csa_sd_percent);
-    char progress[160];
+    fprintf(stderr, " — %.2f s simulated in %.0f s; %s\n", r->simulated_time_s, r->wall_time_s, ending);
+}
+
+// A run done, with the whole calibration's progress.
+static void show_done(const cal_env *env, const char *what, const cal_record *r)
+{
+    char progress[160], ending[200];
     cal_progress_describe(env->progress, progress, sizeof progress);
-    fprintf(stderr, " — %.2f s simulated in %.0f s; %.0f s elapsed%s%s\n", r->simulated_time_s, r->wall_time_s, wall,
-            progress[0] ? "; " : "", progress);
+    snprintf(ending, sizeof ending, "%.0f s elapsed%s%s", exp_wall_seconds() - env->started, progress[0] ? "; " : "",
+             progress);
+    show_record(env, what, r, ending);
 }
 
 // A record every rank must find once a batch is done.
@@ -262,10 +269,9 @@ static void heartbeat_of_bed(heartbeat *h, const char *stage, const exp_drum_def
 // the bed's last speed is done.
 static void announce_stored(const cal_env *env, const char *what, const cal_record *r, int speeds_left)
 {
-    fprintf(stderr, "[%s] %s: %s, angle %.1f° ± %.1f, CSA %.1f %% ± %.1f — %.2f s simulated in %.0f s; stored, %d more "
-                    "speed(s) on this bed\n",
-            env->stage, what, r->status, r->angle_deg, r->angle_sd_deg, r->csa_percent, r->csa_sd_percent,
-            r->simulated_time_s, r->wall_time_s, speeds_left);
+    char ending[64];
+    snprintf(ending, sizeof ending, "stored, %d more speed(s) on this bed", speeds_left);
+    show_record(env, what, r, ending);
 }
 
 // Turn `bed` at run r's speed and store the record; fill_s: the settling's
