@@ -154,13 +154,18 @@ static int planned_candidates(const cal_tier *t)
     return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0);
 }
 
-// "candidate i of at most N" (or "candidates i-j"), with the time left at the pace so far.
+// "candidate i of at most N" (or "candidates i-j"), with the time left at the
+// cost of the candidates so far. That cost is their records' (as the whole
+// calibration's ETA, cal_progress.h), not this process's clock: a resumed
+// stage whose candidates came from the store has spent no time on them.
 static void show_start(const search *s, const double (*mu)[2], int m)
 {
     int planned = planned_candidates(s->t), done = s->r->n;
-    double spent = exp_wall_seconds() - s->started;
+    int parallel = s->env->progress ? s->env->progress->parallel : s->env->workers;
+    double core_s_each = done > 0 ? s->r->core_s / done : 0;
     char eta[48] = "", which[32];
-    if (done > 0) snprintf(eta, sizeof eta, ", stage ETA %.0f s", spent / done * fmax(0, planned - done));
+    if (core_s_each > 0)
+        snprintf(eta, sizeof eta, ", stage ETA %.0f s", core_s_each * fmax(0, planned - done) / fmax(1, parallel));
     if (m == 1) snprintf(which, sizeof which, "candidate %d", done + 1);
     else snprintf(which, sizeof which, "candidates %d-%d", done + 1, done + m);
     fprintf(stderr, "%s[%s] %s of at most %d: ", s->env->tty ? "\r\033[K" : "", s->env->stage, which, planned);
