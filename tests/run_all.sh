@@ -15,7 +15,8 @@ bash .ci/setup
 ctest --test-dir build --output-on-failure -j1 -LE table3
 # Table 3 (label table3): the ci tier as a twin experiment (results/twin_ci/README.md; 868 s on 2 cores
 # here at 6febfdb, one of them running a study), and the standard tier's calibration on the lab data
-# verified from its committed store and compared with Table 3 (results/calibration-standard-affine/README.md).
+# verified from its committed store and compared with Table 3 (results/calibration-standard/README.md;
+# the earlier affine run, results/calibration-standard-affine/, re-derived and compared).
 ctest --test-dir build --output-on-failure -j1 -L table3
 # Without MPI: OpenMPI's MPI_Init loads components whose thread-local storage crashes
 # LeakSanitizer's tracer at exit (every granucal calibrate under ASan ended in "Tracer caught
