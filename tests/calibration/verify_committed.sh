@@ -11,6 +11,7 @@
 #     at most that many seconds (a converged drum's slowest runs take 20 minutes; CI has less), and
 #     the script says how many records that left to draw from.
 #   usage: [MAX_RERUN_S=S] [SEED=N] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
+#   (N = 0: step 1 alone)
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
 # files, and the data files the run read (repose_angle.csv, occupied_area.csv): for a run made with
 # --data they replace its --data folder, and for one made on the config's own files they are read
@@ -55,6 +56,10 @@ else
   fails=$((fails + 1))
 fi
 python3 "$src/tests/calibration/check_value_in_range.py" "$work/out" || fails=$((fails + 1))
+if [ "$n" -eq 0 ]; then # nothing to rerun: a second derivation would only repeat the first
+  echo "$fails failure(s)"
+  exit $((fails > 0))
+fi
 
 # The drum records this command's stages used (simulations.csv: stage, candidate, record, experiment,
 # ...; a two-tier stage lists its map tier's runs as "NAME (map)").
