@@ -157,7 +157,10 @@ int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *e
             fail_at(&r, "row", "%s", "contains a NUL byte: not a text file");
             break;
         }
-        if (blank_or_comment(line)) continue;
+        if (blank_or_comment(line)) {
+            s->synthetic |= strstr(line, "SYNTHETIC") != NULL;
+            continue;
+        }
         if (csv_parse(&p, line, (size_t)n, on_field, on_row, &r) != (size_t)n && !r.failed)
             fail_at(&r, "row", "malformed CSV (%s)", csv_strerror(csv_error(&p)));
         if (!r.failed && line[n - 1] != '\n') csv_fini(&p, on_field, on_row, &r);

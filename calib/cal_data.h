@@ -4,7 +4,9 @@
 /// row by row before any simulation starts:
 ///   repose_angle.csv   surface,rpm,angle_deg,angle_sd_deg   (Table 2)
 ///   occupied_area.csv  surface,rpm,csa_percent,csa_sd_percent (eq. 20)
-/// Lines starting with '#' are comments (provenance, units).
+/// Lines starting with '#' are comments (provenance, units). A comment line
+/// holding the word SYNTHETIC (as `granucal synthesize` writes) marks the
+/// file as simulated, not measured: every output then says so.
 #ifndef CAL_DATA_H
 #define CAL_DATA_H
 
@@ -21,6 +23,7 @@ typedef struct cal_series {
     char path[1024];
     cal_point *points;
     size_t count;
+    int synthetic;    ///< 1 if a comment line says SYNTHETIC: simulated data, not the lab's
 } cal_series;
 
 typedef enum cal_data_kind { CAL_DATA_ANGLE, CAL_DATA_CSA } cal_data_kind;
