@@ -51,7 +51,13 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
     // bound the data do not close gives one side only.
     if (out_identified || out_bracket) v.status = CAL_VALUE_NOT_A_RESULT, v.side = 0;
     else if (none_excluded) v.status = CAL_VALUE_NOT_IDENTIFIED, v.side = 0;
-    else if (v.side) v.status = CAL_VALUE_ONE_SIDED;
+    else if (v.side) {
+        // On the upper bound the data say only that μ is above the nearest
+        // excluded value below (and the mirror on the lower bound).
+        v.status = CAL_VALUE_ONE_SIDED;
+        double other = v.side > 0 ? g.bracket_lo : g.bracket_hi;
+        v.known = isfinite(other) ? other : value;
+    }
     return v;
 }
 
@@ -65,7 +71,7 @@ const char *cal_value_status_name(cal_value_status s)
 const char *cal_verdict_value_text(char *out, size_t len, double value, const cal_verdict *v)
 {
     switch (v->status) {
-    case CAL_VALUE_ONE_SIDED: snprintf(out, len, "%s %.3g", v->side > 0 ? "≥" : "≤", value); break;
+    case CAL_VALUE_ONE_SIDED: snprintf(out, len, "%s %.3g", v->side > 0 ? "≥" : "≤", v->known); break;
     case CAL_VALUE_NOT_IDENTIFIED: snprintf(out, len, "not identified"); break;
     case CAL_VALUE_NOT_A_RESULT: snprintf(out, len, "not a result"); break;
     default: snprintf(out, len, "%.4g", value);
@@ -145,7 +151,7 @@ const char *cal_run_purpose(const cal_run_status *s) { return s->demonstration ?
 
 const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s)
 {
-    snprintf(out, len, "angle %s; CSA %s", s->angle_synthetic ? "synthetic" : "lab", s->csa_synthetic ? "synthetic" : "lab");
+    snprintf(out, len, "angle %s / CSA %s", s->angle_synthetic ? "synthetic" : "lab", s->csa_synthetic ? "synthetic" : "lab");
     return out;
 }
 
@@ -176,7 +182,9 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         if (st == CAL_VALUE_INPUT || st == CAL_VALUE_DERIVED || st == CAL_VALUE_CALIBRATED) continue;
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
-        if (st == CAL_VALUE_ONE_SIDED) fprintf(f, ", only %s %.6g is known", r->verdict.side > 0 ? ">=" : "<=", r->value);
+        if (st == CAL_VALUE_ONE_SIDED)
+            fprintf(f, ", only %s %.6g is known (the search stopped on its bound)", r->verdict.side > 0 ? ">=" : "<=",
+                    r->verdict.known);
         fprintf(f, " (%s)\n", r->verdict.flags);
     }
 }

@@ -31,7 +31,9 @@ typedef enum cal_value_status {
 /// A value's status with the facts behind it.
 typedef struct cal_verdict {
     cal_value_status status;
-    int side;         ///< one-sided: +1 the search's upper bound ("≥"), -1 its lower bound ("≤"); else 0
+    int side;         ///< one-sided: +1 on the search's upper bound, -1 on its lower bound; else 0
+    double known;     ///< one-sided: what the data do say, "≥ known" (side +1) or "≤ known" (side -1): the
+                      ///< other end of the interval no candidate excludes (the value itself if none)
     char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, outside_identified,
                       ///< outside_not_excluded, not_identified, angle_not_matched, stage_not_run,
                       ///< stiffness_at_cylinder_lambda
@@ -46,8 +48,8 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);
 
-/// The value as a person should read it: "0.192", "≥ 1", "not identified",
-/// "not a result". `out` holds at least 48 bytes.
+/// The value as a person should read it: "0.192", "≥ 0.775", "not
+/// identified", "not a result". `out` holds at least 48 bytes.
 const char *cal_verdict_value_text(char *out, size_t len, double value, const cal_verdict *v);
 
 /// One row of the table (Table 3's layout) with its verdict.
@@ -79,7 +81,7 @@ cal_run_status cal_run_status_of(const cal_outcome *o);
 /// "calibration" or "demonstration".
 const char *cal_run_purpose(const cal_run_status *s);
 
-/// The data's provenance in one field without commas: "angle lab; CSA synthetic".
+/// The data's provenance in one field without commas or semicolons: "angle lab / CSA synthetic".
 const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s);
 
 /// The banner every output opens with, each line led by `prefix` ("# ",
