@@ -10,6 +10,7 @@
 
 #include "cal_export.h"
 #include "cal_figures.h"
+#include "cal_posterior.h"
 #include "cal_status.h"
 #include "cal_util.h"
 #include "exp_common.h"
@@ -17,8 +18,49 @@
 
 // ---- the table ---------------------------------------------------------------
 
-static int write_table_csv(const char *dir, const cal_outcome *o, const cal_table_row *rows, int n, char *err,
-                           size_t len)
+// ---- the posteriors -------------------------------------------------------------
+
+// Each friction stage run now, its posterior (cal_posterior.h): [0] the
+// granule stage, [1 + w] wall w. ok 0: not run now (read from a stage file),
+// or no map to sample (why says so).
+typedef struct posteriors {
+    cal_posterior of[17];
+    int ok[17];
+    char why[17][200];
+} posteriors;
+
+static const cal_friction_result *stage_of(const cal_outcome *o, int i) { return i == 0 ? o->granule : o->walls[i - 1]; }
+
+static void posteriors_sample(const cal_outcome *o, posteriors *p)
+{
+    memset(p, 0, sizeof *p);
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+        const cal_friction_result *r = stage_of(o, i);
+        if (r)
+            p->ok[i] = !cal_posterior_sample(r, i ? &o->config->wall : &o->config->granule, &p->of[i], p->why[i],
+                                             sizeof p->why[i]);
+    }
+}
+
+static void posteriors_free(posteriors *p)
+{
+    for (int i = 0; i < 17; ++i) cal_posterior_free(&p->of[i]);
+}
+
+// The posterior of a table row's friction, or NULL.
+static const cal_posterior *row_posterior(const cal_outcome *o, const posteriors *p, const cal_table_row *row, int *param)
+{
+    *param = !strcmp(row->parameter, "mu_r");
+    if (strcmp(row->parameter, "mu_s") && !*param) return NULL;
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+        const cal_friction_result *r = stage_of(o, i);
+        if (r && p->ok[i] && !strcmp(r->material, row->material)) return &p->of[i];
+    }
+    return NULL;
+}
+
+static int write_table_csv(const char *dir, const cal_outcome *o, const posteriors *post, const cal_table_row *rows,
+                           int n, char *err, size_t len)
 {
     char path[1200], data[64];
     snprintf(path, sizeof path, "%s/calibrated_parameters.csv", dir);
@@ -27,14 +69,16 @@ static int write_table_csv(const char *dir, const cal_outcome *o, const cal_tabl
     // identified_min/max: the range of the candidates the data cannot tell
     // apart (cal_friction_identify); not_excluded_min/max: its bracket, the
     // interval no evaluated candidate excludes (cal_range); empty where
-    // nothing was calibrated. status and flags: what the value is
+    // nothing was calibrated. posterior_median, credible_min/max: the
+    // posterior's median and 95 % credible interval (cal_posterior.h), empty
+    // where the stage did not run now. status and flags: what the value is
     // (cal_status.h); tier, lambda, data and purpose: what the run is, on
     // every row, so that no comment line is needed and a row copied alone
     // still says it.
     cal_run_status rs = cal_run_status_of(o);
     cal_run_data_text(data, sizeof data, &rs);
     fputs("contact,material,parameter,value,unit,identified_min,identified_max,not_excluded_min,not_excluded_max,"
-          "status,flags,tier,lambda,data,purpose\n", a.f);
+          "status,flags,tier,lambda,data,purpose,posterior_median,credible_min,credible_max\n", a.f);
     for (int i = 0; i < n; ++i) {
         const cal_range *g = &rows[i].range;
         fprintf(a.f, "%s,%s,%s,%.6g,%s,", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
@@ -42,8 +86,12 @@ static int write_table_csv(const char *dir, const cal_outcome *o, const cal_tabl
         else fputs(",,", a.f);
         if (isfinite(g->bracket_lo)) fprintf(a.f, "%.6g,%.6g,", g->bracket_lo, g->bracket_hi);
         else fputs(",,", a.f);
-        fprintf(a.f, "%s,%s,%s,%g,%s,%s\n", cal_value_status_name(rows[i].verdict.status), rows[i].verdict.flags,
+        fprintf(a.f, "%s,%s,%s,%g,%s,%s,", cal_value_status_name(rows[i].verdict.status), rows[i].verdict.flags,
                 rs.tier, rs.drum_lambda, data, cal_run_purpose(&rs));
+        int p;
+        const cal_posterior *q = row_posterior(o, post, &rows[i], &p);
+        if (q) fprintf(a.f, "%.6g,%.6g,%.6g\n", q->median[p], q->lo[p], q->hi[p]);
+        else fputs(",,\n", a.f);
     }
     return cal_atomic_commit(&a, err, len);
 }
@@ -89,17 +137,38 @@ static const char *value_cell(char out[160], const cal_table_row *r)
     return out;
 }
 
-// One row of the Markdown table: label, material, value, status and flags, range, source.
-static void md_row(FILE *f, const char *contact, const char *label, const cal_table_row *r, const char *source)
+typedef struct md_table {
+    FILE *f;
+    const cal_outcome *o;
+    const posteriors *post;
+} md_table;
+
+// The posterior's median and 95 % credible interval of a friction row, or "".
+static const char *posterior_cell(char out[96], const md_table *t, const cal_table_row *r)
 {
-    char value[160], range[160];
-    fprintf(f, "| %s | %s | %s | %s | %s%s%s%s | %s | %s |\n", contact, label, r->material, value_cell(value, r),
-            cal_value_status_name(r->verdict.status), r->verdict.flags[0] ? " (" : "", r->verdict.flags,
-            r->verdict.flags[0] ? ")" : "", range_cell(range, r->range, r->value), source);
+    int p;
+    const cal_posterior *q = row_posterior(t->o, t->post, r, &p);
+    if (!q) return out[0] = '\0', out;
+    snprintf(out, 96, "%.3g [%.3g – %.3g]%s", q->median[p], q->lo[p], q->hi[p],
+             q->reaches_lower[p] && q->reaches_upper[p] ? " (both bounds)"
+             : q->reaches_lower[p]                     ? " (to the lower bound)"
+             : q->reaches_upper[p]                     ? " (to the upper bound)"
+                                                       : "");
+    return out;
 }
 
-static int write_table_md(const char *dir, const cal_outcome *o, const cal_table_row *rows, int n, char *err,
-                          size_t len)
+// One row of the Markdown table: label, material, value, status and flags, range, posterior, source.
+static void md_row(const md_table *t, const char *contact, const char *label, const cal_table_row *r, const char *source)
+{
+    char value[160], range[160], posterior[96];
+    fprintf(t->f, "| %s | %s | %s | %s | %s%s%s%s | %s | %s | %s |\n", contact, label, r->material, value_cell(value, r),
+            cal_value_status_name(r->verdict.status), r->verdict.flags[0] ? " (" : "", r->verdict.flags,
+            r->verdict.flags[0] ? ")" : "", range_cell(range, r->range, r->value), posterior_cell(posterior, t, r),
+            source);
+}
+
+static int write_table_md(const char *dir, const cal_outcome *o, const posteriors *post, const cal_table_row *rows,
+                          int n, char *err, size_t len)
 {
     const cal_table *t = &o->table;
     char path[1200];
@@ -109,22 +178,23 @@ static int write_table_md(const char *dir, const cal_outcome *o, const cal_table
     FILE *f = a.f;
     cal_run_status rs = cal_run_status_of(o);
     cal_run_status_banner(f, &rs, "> ");
-    fputs("\n| Contact | Parameter | Material | Value | Status | Identified range (95 %) | Source |\n"
-          "|---|---|---|---|---|---|---|\n", f);
+    fputs("\n| Contact | Parameter | Material | Value | Status | Identified range (95 %) | Posterior median [95 % "
+          "credible] | Source |\n|---|---|---|---|---|---|---|---|\n", f);
+    const md_table m = {f, o, post};
     const char *gg = "granule-granule", *gw = "granule-boundary";
-    md_row(f, "Granule–granule", "Granule density ρ_g (kg/m³)", find_row(rows, n, gg, "", "density"), "config");
-    md_row(f, "", "Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m)", find_row(rows, n, gg, "", "k_n"),
+    md_row(&m, "Granule–granule", "Granule density ρ_g (kg/m³)", find_row(rows, n, gg, "", "density"), "config");
+    md_row(&m, "", "Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m)", find_row(rows, n, gg, "", "k_n"),
            t->k_source);
-    md_row(f, "", "Damping ratio ξ", find_row(rows, n, gg, "", "xi"), "config");
-    md_row(f, "", "Sliding friction μs,g-g", find_row(rows, n, gg, "", "mu_s"), t->gg_source);
-    md_row(f, "", "Rolling friction μr,g-g", find_row(rows, n, gg, "", "mu_r"), t->gg_source);
-    md_row(f, "Granule–boundary", "k_n = k_s = k_r (N/m)", find_row(rows, n, gw, "", "k_n"),
+    md_row(&m, "", "Damping ratio ξ", find_row(rows, n, gg, "", "xi"), "config");
+    md_row(&m, "", "Sliding friction μs,g-g", find_row(rows, n, gg, "", "mu_s"), t->gg_source);
+    md_row(&m, "", "Rolling friction μr,g-g", find_row(rows, n, gg, "", "mu_r"), t->gg_source);
+    md_row(&m, "Granule–boundary", "k_n = k_s = k_r (N/m)", find_row(rows, n, gw, "", "k_n"),
            "2 k_n, springs in series (Table 3)");
-    md_row(f, "", "Damping ratio ξ", find_row(rows, n, gw, "", "xi"), "config");
+    md_row(&m, "", "Damping ratio ξ", find_row(rows, n, gw, "", "xi"), "config");
     for (int w = 0; w < t->n_walls; ++w)
-        md_row(f, "", "Sliding friction μs,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_s"), t->wall_source[w]);
+        md_row(&m, "", "Sliding friction μs,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_s"), t->wall_source[w]);
     for (int w = 0; w < t->n_walls; ++w)
-        md_row(f, "", "Rolling friction μr,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_r"), t->wall_source[w]);
+        md_row(&m, "", "Rolling friction μr,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_r"), t->wall_source[w]);
     return cal_atomic_commit(&a, err, len);
 }
 
@@ -411,6 +481,42 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
     report_identified(f, r, bounds);
 }
 
+// A stage's posterior beside its Δχ² ranges, and which measurement moves with which parameter.
+static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bounds *b, const cal_posterior *p,
+                             const char *why)
+{
+    if (!p) {
+        fprintf(f, "\nNo posterior: %s.\n", why);
+        return;
+    }
+    fprintf(f, "\nPosterior of (μs, log10 μr) given the data (MCMC, %d samples over %d chains, acceptance %.2f; flat "
+               "prior over the search's bounds), on %s; each measurement's spread is the data's, the map's rms "
+               "residual and the kriging's own, in quadrature. The chains' medians lie within %.3f (μs) and %.3f "
+               "(log μr) of the search range of each other.\n\n| | median | 95 %% credible interval | Δχ² identified "
+               "(not excluded) |\n|---|---|---|---|\n",
+            p->n, CAL_POSTERIOR_CHAINS, p->acceptance, p->model, p->chain_spread[0], p->chain_spread[1]);
+    const cal_range *g[2] = {&r->mu_s_range, &r->mu_r_range};
+    const char *names[2] = {"μs", "μr"};
+    for (int k = 0; k < 2; ++k)
+        fprintf(f, "| %s | %.3g | %.3g – %.3g%s | %.3g – %.3g (%.3g – %.3g) |\n", names[k], p->median[k], p->lo[k],
+                p->hi[k], p->reaches_lower[k] && p->reaches_upper[k] ? " (both bounds)"
+                          : p->reaches_lower[k]                      ? " (to the lower bound)"
+                          : p->reaches_upper[k]                      ? " (to the upper bound)"
+                                                                     : "",
+                g[k]->lo, g[k]->hi, g[k]->bracket_lo, g[k]->bracket_hi);
+    fputs("\nWhat each measurement can tell (its change across each parameter's whole search range, the other at "
+          "its posterior median, in the data's spreads; below 1 it cannot tell that parameter at all):\n\n"
+          "| measurement | data spread | across μs | across μr |\n|---|---|---|---|\n", f);
+    for (int k = 0; k < p->n_y; ++k)
+        fprintf(f, "| %s | %.3g | %+.2f | %+.2f |\n", p->observable[k], p->data_sd[k], p->sensitivity[k][0],
+                p->sensitivity[k][1]);
+    double lo[2] = {b->mu_s_min, b->mu_r_min}, hi[2] = {b->mu_s_max, b->mu_r_max};
+    for (int k = 0; k < 2; ++k)
+        if (cal_posterior_blind(p, k))
+            fprintf(f, "\n**The data cannot tell this stage's %s**: no measurement moves by one spread across its "
+                       "whole search range; any value in %.3g – %.3g fits.\n", names[k], lo[k], hi[k]);
+}
+
 static void cost_row(FILE *f, const char *stage, const char *tier, int candidates, int simulations, double core_s)
 {
     fprintf(f, "| %s | %s | %d | %d | %.2f |\n", stage, tier, candidates, simulations, core_s / 3600);
@@ -446,7 +552,8 @@ static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
           "systems spend about 80 (GrainLearning) to 480 (ACCES) simulations per calibration.\n", f);
 }
 
-static int write_report(const char *dir, const cal_outcome *o, const sim_tally *tally, char *err, size_t len)
+static int write_report(const char *dir, const cal_outcome *o, const posteriors *post, const sim_tally *tally,
+                        char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/report.md", dir);
@@ -490,8 +597,12 @@ static int write_report(const char *dir, const cal_outcome *o, const sim_tally *
                        "cylinder λ 32768 the CN rose below 50 N/m, results/stiffness_low_k/).\n",
                     s->k[0], o->config->k_n);
     }
-    if (o->granule) report_friction(f, o->granule, &o->config->granule);
-    for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w], &o->config->wall);
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i)
+        if (stage_of(o, i)) {
+            const cal_bounds *b = i ? &o->config->wall : &o->config->granule;
+            report_friction(f, stage_of(o, i), b);
+            report_posterior(f, stage_of(o, i), b, post->ok[i] ? &post->of[i] : NULL, post->why[i]);
+        }
     report_cost(f, o, tally);
     cal_export_report(f, dir);
     return cal_atomic_commit(&a, err, len);
@@ -504,10 +615,15 @@ int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t le
     char store[1100];
     snprintf(store, sizeof store, "%s/store", dir);
     sim_tally tally = {0};
-    int bad = write_table_csv(dir, o, rows, n, err, len) || write_table_md(dir, o, rows, n, err, len) ||
+    posteriors *post = malloc(sizeof *post);
+    if (!post) return exp_fail(err, len, "out of memory");
+    posteriors_sample(o, post);
+    int bad = write_table_csv(dir, o, post, rows, n, err, len) || write_table_md(dir, o, post, rows, n, err, len) ||
               write_table_h5(dir, o, rows, n, err, len) || cal_export_write(dir, o, err, len) ||
-              write_simulations(dir, store, o, &tally, err, len) || write_report(dir, o, &tally, err, len);
+              write_simulations(dir, store, o, &tally, err, len) || write_report(dir, o, post, &tally, err, len);
     free(tally.hash);
+    posteriors_free(post);
+    free(post);
     if (bad) return 1;
     if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
     if (o->granule && cal_figures_friction(dir, &o->config->granule, o->granule, err, len)) return 1;

@@ -78,10 +78,12 @@ static double squared_z(double value, double target, double sd, int usable)
     return usable && isfinite(z) ? z * z : failed_speed_penalty;
 }
 
+double cal_friction_angle_spread(const cal_friction_result *r) { return fmax(r->angle_tolerance, min_angle_sd); }
+
 // The angle's squared z-score against its tolerance.
 static double angle_z2(const cal_friction_result *r, const cal_candidate *k)
 {
-    return squared_z(k->angle_deg, r->angle_target, fmax(r->angle_tolerance, min_angle_sd), 1);
+    return squared_z(k->angle_deg, r->angle_target, cal_friction_angle_spread(r), 1);
 }
 
 // Speed i's CSA spread: the lab's (floored), and the tier's added in quadrature (tier_sd 0: the lab's alone).
@@ -92,6 +94,17 @@ static double csa_spread(const cal_friction_result *r, int i, double tier_sd)
 }
 
 double cal_friction_csa_spread(const cal_friction_result *r, int i) { return csa_spread(r, i, r->csa_tier_sd[i]); }
+
+int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y)
+{
+    if (!isfinite(k->angle_deg)) return 1;
+    y[0] = k->angle_deg;
+    for (int i = 0; i < r->n_rpm; ++i) {
+        if (!k->usable[i] || !isfinite(k->csa[i])) return 1;
+        y[1 + i] = k->csa[i];
+    }
+    return 0;
+}
 
 // Speed i's CSA squared z-score against csa_spread.
 static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
