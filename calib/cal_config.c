@@ -27,6 +27,7 @@ static const cyaml_schema_value_t material_entry = {CYAML_VALUE_MAPPING(CYAML_FL
 static const cyaml_strval_t yes_no[] = {{"false", 0}, {"true", 1}, {"no", 0}, {"yes", 1}};
 static const cyaml_strval_t corrections[] = {{"kriging", CAL_MF_KRIGING}, {"affine", CAL_MF_AFFINE}};
 static const cyaml_strval_t purposes[] = {{"calibration", 0}, {"demonstration", 1}};
+static const cyaml_strval_t stiffness_scenes[] = {{"cylinder", 0}, {"drum", 1}};
 
 #define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
 static const cyaml_schema_field_t tier_fields[] = {
@@ -45,6 +46,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
     TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
     CYAML_FIELD_SEQUENCE("stiffness", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, stiffness, &float_entry, 2, 64),
+    CYAML_FIELD_ENUM_PTR("stiffness_scene", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, stiffness_scene,
+                         stiffness_scenes, CYAML_ARRAY_LEN(stiffness_scenes)),
     CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
     CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
     CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
@@ -285,6 +288,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
 int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_is_demonstration(const cal_tier *t) { return t->demonstration && *t->demonstration; }
+int cal_tier_stiffness_on_drum(const cal_tier *t) { return t->stiffness_scene && *t->stiffness_scene; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
 const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n)
 {

@@ -47,7 +47,11 @@ typedef struct cal_tier {
     /// k (results/stiffness_low_k/), so a tier may need softer candidates.
     double *stiffness;
     unsigned stiffness_count;
-    int seeds;              ///< poured cylinders per stiffness (seed-to-seed spread)
+    /// Stage 1's bed: the poured cylinder (0, absent: `cylinder`, at
+    /// cylinder_lambda) or the tier's own drum (1: `drum`, exp_drum_bed.h: its
+    /// λ, slice, fill and fill method, poured with pour_mu_s, pour_mu_r).
+    int *stiffness_scene;
+    int seeds;              ///< poured beds per stiffness (seed-to-seed spread)
     int grid;               ///< initial design: grid points per axis of (μs, log μr)
     int max_evaluations;    ///< NLopt evaluations after the grid
     double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
@@ -93,6 +97,8 @@ int cal_tier_angle_in_misfit(const cal_tier *t);
 int cal_tier_beds(const cal_tier *t);
 /// 1 if the tier's purpose is demonstration (cal_tier.demonstration).
 int cal_tier_is_demonstration(const cal_tier *t);
+/// 1 if stage 1 sweeps the stiffness on the tier's drum (stiffness_scene: drum).
+int cal_tier_stiffness_on_drum(const cal_tier *t);
 /// 1 if the tier probes the μr bounds after the search (the default).
 int cal_tier_bound_probes(const cal_tier *t);
 /// The tier's map_correction (kriging when absent).

@@ -14,6 +14,7 @@
 #include "dem_checkpoint.h"
 #include "exp_common.h"
 #include "exp_contact_rules.h"
+#include "exp_drum_bed.h"
 
 // How this environment's drum runs are counted in the progress.
 static cal_run_kind drum_kind(const cal_env *env) { return env->mapping ? CAL_RUN_MAP_DRUM : CAL_RUN_DRUM; }
@@ -79,6 +80,16 @@ exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, 
     return d;
 }
 
+cal_bed_case cal_bed_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed)
+{
+    cal_bed_case b = {.on_drum = cal_tier_stiffness_on_drum(t)};
+    b.cylinder = cal_cylinder_case_make(c, t, k_n, seed);
+    // The drum lined with granules at the pour's prior friction, as the cylinder is.
+    b.drum_bed = drum_case(c, t, k_n, c->pour_mu_s, c->pour_mu_r, c->pour_mu_s, c->pour_mu_r).fill;
+    b.drum_bed.seed = seed;
+    return b;
+}
+
 static void contact_text(char *out, size_t len, const dem_contact_params *p)
 {
     snprintf(out, len, "k=%.10g,%.10g,%.10g xi=%.10g mu=%.10g,%.10g damping=%d", p->k_n, p->k_s, p->k_r, p->xi,
@@ -140,13 +151,24 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
              c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
 }
 
+void cal_bed_key(const cal_bed_case *b, char *out, size_t len)
+{
+    if (!b->on_drum) {
+        cal_cylinder_key(&b->cylinder, out, len);
+        return;
+    }
+    char def[1024];
+    drum_def_text(&b->drum_bed, def, sizeof def);
+    snprintf(out, len, "drum_bed %s", def);
+}
+
 // "[stage] what: status (reason), angle ..., CSA ... — T s simulated in W s; ENDING"
 static void show_record(const cal_env *env, const char *what, const cal_record *r, const char *ending)
 {
     if (env->tty) fputs("\r\033[K", stderr);
     fprintf(stderr, "[%s] %s: %s", env->stage, what, r->status);
     if (r->reason && r->reason[0]) fprintf(stderr, " (%s)", r->reason);
-    if (r->granules && strncmp(what, "cylinder", 8) == 0)
+    if (r->granules && (strncmp(what, "cylinder", 8) == 0 || strncmp(what, "drum bed", 8) == 0))
         fprintf(stderr, ", CN %.3f, %d granules", r->coordination, r->granules);
     else if (r->granules)
         fprintf(stderr, ", angle %.1f° ± %.1f, CSA %.1f %% ± %.1f", r->angle_deg, r->angle_sd_deg, r->csa_percent,
@@ -524,23 +546,25 @@ int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, i
     return cal_drum_evaluate_many(env, c, 1, rpm, n, out, err, len);
 }
 
-// ---- poured cylinder --------------------------------------------------------
+// ---- stage-1 beds: the poured cylinder or the drum's bed ----------------------
 
-typedef struct cylinder_batch {
+typedef struct bed_batch {
     cal_env *env;
-    const exp_cylinder_def *cases;
+    const cal_bed_case *cases;
     int *todo;
     char (*keys)[2048];
-} cylinder_batch;
+} bed_batch;
 
 static int pour_one(int i, void *ctx)
 {
-    cylinder_batch *b = ctx;
+    bed_batch *b = ctx;
     int k = b->todo[i];
+    const cal_bed_case *c = &b->cases[k];
     double t0 = exp_wall_seconds();
     char err[1024];
     exp_cylinder_result res;
-    dem_world *w = exp_cylinder_run(&b->cases[k], NULL, NULL, &res, err, sizeof err);
+    dem_world *w = c->on_drum ? exp_drum_bed_run(&c->drum_bed, NULL, NULL, &res, err, sizeof err)
+                              : exp_cylinder_run(&c->cylinder, NULL, NULL, &res, err, sizeof err);
     if (!w) return write_failed(b->env, b->keys[k], err), 1;
     cal_record r = {.key = b->keys[k], .status = "ok", .reason = ""};
     r.coordination = res.coordination, r.coordination_interior = res.coordination_interior;
@@ -556,15 +580,15 @@ static int pour_one(int i, void *ctx)
 
 static void poured(int i, int code, void *ctx)
 {
-    cylinder_batch *b = ctx;
-    int k = b->todo[i];
+    bed_batch *b = ctx;
+    const cal_bed_case *c = &b->cases[b->todo[i]];
     char what[96];
-    snprintf(what, sizeof what, "cylinder k_n = %g N/m, seed %llu", b->cases[k].granule.k_n,
-             (unsigned long long)b->cases[k].seed);
-    finish_run(b->env, CAL_RUN_CYLINDER, b->keys[k], what, code);
+    snprintf(what, sizeof what, "%s k_n = %g N/m, seed %llu", c->on_drum ? "drum bed" : "cylinder",
+             c->cylinder.granule.k_n, (unsigned long long)c->cylinder.seed);
+    finish_run(b->env, CAL_RUN_CYLINDER, b->keys[b->todo[i]], what, code);
 }
 
-int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len)
+int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record *out, char *err, size_t len)
 {
     char(*keys)[2048] = calloc((size_t)n, sizeof *keys);
     int *todo = calloc((size_t)n, sizeof *todo), n_todo = 0, n_missing = 0, bad = 0;
@@ -572,14 +596,14 @@ int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, ca
     if (!keys || !todo || !missing) return free(keys), free(todo), free(missing), exp_fail(err, len, "out of memory"), 1;
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
-        cal_cylinder_key(&cases[k], keys[k], sizeof keys[k]);
+        cal_bed_key(&cases[k], keys[k], sizeof keys[k]);
         int got = cal_store_get(env->store, keys[k], &out[k], err, len);
         bad = got < 0;
         missing[k] = got == 1;
         if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k, missing[k] = 0;
         if (got == 0) count_stored(env, CAL_RUN_CYLINDER, &out[k]);
     }
-    cylinder_batch b = {env, cases, todo, keys};
+    bed_batch b = {env, cases, todo, keys};
     if (!bad && n_todo > 0) cal_pool_run(n_todo, pour_one, poured, &b, env->workers, env->use_fork);
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {

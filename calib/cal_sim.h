@@ -85,6 +85,20 @@ void cal_sim_release(cal_env *env);
 /// The poured cylinder of stage 1 at stiffness k_n and seed.
 exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);
 
+/// A stage-1 bed: the poured cylinder, or the tier's drum's own poured bed
+/// (its tier's stiffness_scene), both poured with the config's prior friction.
+typedef struct cal_bed_case {
+    int on_drum;               ///< 1: drum_bed (exp_drum_bed_run), 0: cylinder (exp_cylinder_run)
+    exp_cylinder_def cylinder;
+    exp_drum_def drum_bed;     ///< the tier's drum, granule and wall pairs at pour_mu_s, pour_mu_r
+} cal_bed_case;
+
+/// Stage 1's bed at tier t, stiffness k_n and seed, in the tier's scene.
+cal_bed_case cal_bed_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);
+/// Its record's key: the cylinder's key (cal_cylinder_key), or "drum_bed "
+/// and the drum definition's text (all that defines the settled bed).
+void cal_bed_key(const cal_bed_case *b, char *out, size_t len);
+
 /// The text that defines a simulation (hashed into its record's name).
 void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len);
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
@@ -100,7 +114,7 @@ int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, i
 int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
                            cal_record *out, char *err, size_t len);
 
-/// Records of poured cylinders, running the missing ones side by side.
-int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, cal_record *out, char *err, size_t len);
+/// Records of stage-1 beds, running the missing ones side by side.
+int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record *out, char *err, size_t len);
 
 #endif

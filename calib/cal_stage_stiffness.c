@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
-// Stage 1 (section 4.1, Fig. 12): the poured cylinder's coordination number
-// against the granule stiffness; keep the smallest k whose coordination
-// number is within the seed-to-seed noise of the stiff limit.
+// Stage 1 (section 4.1, Fig. 12): a poured bed's coordination number against
+// the granule stiffness; keep the smallest k whose coordination number is
+// within the seed-to-seed noise of the stiff limit. The bed is the poured
+// cylinder, or the tier's drum's own bed (stiffness_scene: drum): the
+// cylinder's knee did not move with its λ as eq. 15-18 would have it
+// (results/stiffness_low_k/), so a tier may sweep where its drum runs.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,25 +75,26 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
     const double *stiffness = cal_tier_stiffness(c, t, &n_k);
     int seeds = t->seeds, n = (int)n_k;
     if (n > CAL_MAX_K) return exp_fail(err, len, "at most %d stiffness candidates", CAL_MAX_K);
-    exp_cylinder_def *cases = calloc((size_t)(n * seeds), sizeof *cases);
+    cal_bed_case *cases = calloc((size_t)(n * seeds), sizeof *cases);
     cal_record *rec = calloc((size_t)(n * seeds), sizeof *rec);
     if (!cases || !rec) return free(cases), free(rec), exp_fail(err, len, "out of memory");
     out->n = n;
+    out->scene = cal_tier_stiffness_on_drum(t) ? "the drum's poured bed" : "poured cylinder";
     for (int i = 0; i < n; ++i) {
         out->k[i] = stiffness[i];
         for (int j = 0; j < seeds; ++j)
-            cases[i * seeds + j] = cal_cylinder_case_make(c, t, stiffness[i], (uint64_t)(c->seed + j));
+            cases[i * seeds + j] = cal_bed_case_make(c, t, stiffness[i], (uint64_t)(c->seed + j));
     }
     cal_env_set_stage(env, "stiffness");
     cal_progress_enter(env->progress, env->stage);
-    int bad = cal_cylinder_evaluate(env, cases, n * seeds, rec, err, len);
+    int bad = cal_bed_evaluate(env, cases, n * seeds, rec, err, len);
     if (!bad) {
         summarise(out, rec, seeds);
         out->stiff_limit = out->cn_mean[n - 1];
         out->tolerance = c->stiffness_tolerance > 0 ? c->stiffness_tolerance : noise_tolerance(out, seeds);
         out->tolerance_rule = c->stiffness_tolerance > 0 ? "stiffness_tolerance of the config"
                                                           : "two standard errors of a difference of seed means";
-        if (!isfinite(out->stiff_limit)) bad = exp_fail(err, len, "the stiffest cylinder (k_n = %g N/m) failed every seed", out->k[n - 1]);
+        if (!isfinite(out->stiff_limit)) bad = exp_fail(err, len, "the stiffest %s (k_n = %g N/m) failed every seed", out->scene, out->k[n - 1]);
         else cal_stiffness_choose(out);
     }
     for (int i = 0; i < n * seeds; ++i) cal_record_free(&rec[i]);

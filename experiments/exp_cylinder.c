@@ -2,6 +2,7 @@
 // The poured cylinder (section 4.1): pour, cut at the rim, settle, count.
 #include "exp_cylinder.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -67,25 +68,35 @@ static dem_world *create_container(const exp_cylinder_def *d, char *err, size_t 
     return w;
 }
 
-// Interior coordination number and solid fraction of the bed at rest.
-static void count_contacts(const dem_world *w, const exp_cylinder_def *d, double dmax, exp_cylinder_result *out)
+int exp_count_bed_contacts(const dem_world *w, double dmax, exp_interior_fn interior, const void *ctx,
+                           exp_cylinder_result *out, double *solid_volume)
 {
+    dem_diagnostics diag = dem_world_diagnose(w);
+    out->granules = diag.granules;
+    out->coordination = diag.coordination;
+    out->wall_contacts_per_granule = diag.granules ? (double)diag.wall_contacts / (double)diag.granules : 0;
     dem_granules_view g = dem_world_granules(w);
     unsigned *z = malloc((g.count + 1) * sizeof *z);
-    if (!z) return;
+    if (!z) return 1;
     dem_world_contact_counts(w, z);
-    double r = 0.5 * d->diameter, top = 0, sum_in = 0, solid = 0;
+    double top = -INFINITY, sum_in = 0, solid = 0;
     size_t n_in = 0;
     for (size_t i = 0; i < g.count; ++i) top = fmax(top, g.position[i].y);
     for (size_t i = 0; i < g.count; ++i) {
-        dem_vec3 p = g.position[i];
         solid += 4.0 / 3.0 * DEM_PI * g.radius[i] * g.radius[i] * g.radius[i];
-        int interior = sqrt(p.x * p.x + p.z * p.z) < r - dmax && p.y > dmax && p.y < top - dmax;
-        if (interior) sum_in += z[i], n_in++;
+        if (interior(g.position[i], top, dmax, ctx)) sum_in += z[i], n_in++;
     }
     free(z);
     out->coordination_interior = n_in ? sum_in / (double)n_in : NAN;
-    out->solid_fraction = solid / (DEM_PI * r * r * d->depth);
+    *solid_volume = solid;
+    return 0;
+}
+
+// At least d_max from the container's side and floor (y = 0) and below the free surface.
+static int inside_cylinder(dem_vec3 p, double top, double dmax, const void *ctx)
+{
+    double r = 0.5 * ((const exp_cylinder_def *)ctx)->diameter;
+    return sqrt(p.x * p.x + p.z * p.z) < r - dmax && p.y > dmax && p.y < top - dmax;
 }
 
 dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress, void *ctx, exp_cylinder_result *out,
@@ -111,11 +122,13 @@ dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress,
         dem_world_destroy(w);
         return NULL;
     }
-    dem_diagnostics diag = dem_world_diagnose(w);
-    out->granules = diag.granules;
-    out->coordination = diag.coordination;
-    out->wall_contacts_per_granule = diag.granules ? (double)diag.wall_contacts / (double)diag.granules : 0;
+    double solid, r = 0.5 * d->diameter;
+    if (exp_count_bed_contacts(w, dem_gsd_max_diameter(&gsd), inside_cylinder, d, out, &solid)) {
+        exp_fail(err, len, "poured cylinder: out of memory counting contacts");
+        dem_world_destroy(w);
+        return NULL;
+    }
+    out->solid_fraction = solid / (DEM_PI * r * r * d->depth);
     out->simulated_time_s = dem_world_time(w);
-    count_contacts(w, d, dem_gsd_max_diameter(&gsd), out);
     return w;
 }

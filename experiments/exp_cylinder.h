@@ -26,13 +26,14 @@ typedef struct exp_cylinder_def {
 
 exp_cylinder_def exp_default_cylinder_def(void);
 
-/// Coordination numbers of the bed at rest.
+/// Coordination numbers of a poured bed at rest: the cylinder's, or the
+/// drum's own bed (exp_drum_bed.h), counted by one rule (exp_count_bed_contacts).
 typedef struct exp_cylinder_result {
     size_t granules;
     double coordination;          ///< granule–granule contacts per granule, 2C/N (walls not counted)
     double coordination_interior; ///< the same over granules at least d_max from walls and free surface
     double wall_contacts_per_granule; ///< granule–wall contacts per granule, stated separately
-    double solid_fraction;        ///< solid volume over the container volume below the rim
+    double solid_fraction;        ///< solid volume over the bed's volume (the cylinder's: the container below the rim)
     double simulated_time_s;
 } exp_cylinder_result;
 
@@ -49,6 +50,19 @@ typedef struct exp_cylinder_cost {
 } exp_cylinder_cost;
 
 exp_cylinder_cost exp_cylinder_predict_cost(const exp_cylinder_def *d);
+
+/// Whether a granule at p is interior: at least dmax (the largest diameter)
+/// from every wall and below the free surface (top: the highest granule
+/// centre) by dmax. ctx: the scene's definition.
+typedef int (*exp_interior_fn)(dem_vec3 p, double top, double dmax, const void *ctx);
+
+/// Count the contacts of a bed at rest, the one rule of every stage-1 scene:
+/// granules, coordination (2C/N granule-granule, dem_world_diagnose), wall
+/// contacts per granule, and the interior coordination over the granules
+/// `interior` accepts (NAN: none); *solid_volume: the granules' volume. The
+/// scene sets solid_fraction and simulated_time_s. 1 when out of memory.
+int exp_count_bed_contacts(const dem_world *w, double dmax, exp_interior_fn interior, const void *ctx,
+                           exp_cylinder_result *out, double *solid_volume);
 
 /// Pour, cut at the rim, settle, and count contacts. NULL world on error.
 dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress, void *ctx, exp_cylinder_result *out,
