@@ -18,8 +18,9 @@
 #include "cal_sim.h"
 #include "cal_stages.h"
 #include "cal_util.h"
+#include "exp_common.h"
 
-static const double candidates[] = {50, 800};
+static const double candidates[] = {10, 50}; // soft: cheap (a stiffer bed needs a smaller step)
 enum { N_K = 2 };
 
 static void source_path(const char *rel, char *path, size_t len)
@@ -68,7 +69,7 @@ static void stage_one(cal_env *env, const char *store, const cal_config *c, cal_
 {
     memset(env, 0, sizeof *env);
     snprintf(env->store, sizeof env->store, "%s", store);
-    env->workers = 1, env->use_fork = 0;
+    env->workers = 1, env->use_fork = 0, env->started = exp_wall_seconds();
     char err[1024];
     if (cal_stage_stiffness(env, c, cal_config_tier(c), out, err, sizeof err)) fail_msg("%s", err);
 }
