@@ -50,7 +50,9 @@ int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, char *e
     series[2] = level(lower, "stiff limit ± tolerance", grey, 1);
     series[3] = level(upper, NULL, grey, 1);
     series[4] = points(1, chosen_k, chosen_cn, chosen_label, red, s->resolved ? EXP_MARK_STAR : EXP_MARK_OPEN_CIRCLE);
-    exp_plot_axes axes = {.title = "Stage 1: coordination number of the poured cylinder (Fig. 12)",
+    char title[96];
+    snprintf(title, sizeof title, "Stage 1: coordination number of the %s (Fig. 12)", s->scene ? s->scene : "poured cylinder");
+    exp_plot_axes axes = {.title = title,
                           .xlabel = "granule stiffness k_n (N/m, real powder)",
                           .ylabel = "coordination number (granule–granule)", .log_x = 1};
     return exp_plot_png(path, &axes, 5, series, WIDTH, HEIGHT, err, len);
