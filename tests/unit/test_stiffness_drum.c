@@ -48,6 +48,14 @@ static void write_config(const char *dir, const char *lines, char *out, size_t l
     assert_true(added);
 }
 
+// Remove a scratch folder this test made (its name is ours: no quoting needed).
+static void remove_scratch(const char *dir)
+{
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);
+}
+
 static cal_config *load(const char *dir, const char *lines)
 {
     char path[1100], err[1024];
@@ -124,6 +132,7 @@ static void test_drum_bed_recorded_resumed_chosen(void **state)
     for (int i = 0; i < N_K; ++i) assert_true(resumed.cn_mean[i] == s.cn_mean[i] && resumed.cn_sd[i] == s.cn_sd[i]);
     assert_true(same(resumed.chosen_k, s.chosen_k) && resumed.resolved == s.resolved);
     cal_config_free(c);
+    remove_scratch(dir);
 }
 
 // Without the key (or with `cylinder`) stage 1 pours the cylinder under the
@@ -145,6 +154,7 @@ static void test_cylinder_by_default(void **state)
         assert_string_equal(bed_key, cyl_key);
         cal_config_free(c);
     }
+    remove_scratch(dir);
 }
 
 static void test_unknown_scene_refused(void **state)
@@ -157,6 +167,7 @@ static void test_unknown_scene_refused(void **state)
     assert_null(c);
     printf("%s\n", err);
     assert_non_null(strstr(err, "stiffness_scene"));
+    remove_scratch(dir);
 }
 
 int main(void)
