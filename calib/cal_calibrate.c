@@ -297,8 +297,9 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
     if (wants(r, "stiffness")) {
         unsigned n;
         cal_tier_stiffness(r->c, r->t, &n);
-        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (cylinder λ = %g)\n", n, r->t->seeds,
-                r->t->cylinder_lambda);
+        int drum = cal_tier_stiffness_on_drum(r->t);
+        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (%s λ = %g)\n", n, r->t->seeds,
+                drum ? "the drum's own bed," : "cylinder", drum ? r->t->lambda : r->t->cylinder_lambda);
         if (cal_stage_stiffness(&r->env, r->c, r->t, &r->stiffness, r->err, sizeof r->err)) return 1;
         if (!isfinite(r->stiffness.chosen_k))
             return exp_fail(r->err, sizeof r->err, "stage 1: no candidate's CN is within the tolerance of the stiff limit");
@@ -308,7 +309,8 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
             *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
             return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
         }
-        *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)", r->table.k_calibrated = 1;
+        *k_n = r->stiffness.chosen_k, r->table.k_calibrated = 1;
+        *source = drum ? "stage 1 (the drum's poured bed, Fig. 12)" : "stage 1 (poured cylinder, Fig. 12)";
         return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
     }
     stage_file s;
@@ -433,10 +435,10 @@ static double cylinders_core_s(const run *r, double *memory_mb)
     unsigned n;
     const double *stiffness = cal_tier_stiffness(r->c, r->t, &n);
     for (unsigned k = 0; k < n; ++k) {
-        exp_cylinder_def d = cal_cylinder_case_make(r->c, r->t, stiffness[k], 1);
-        exp_cylinder_cost c = exp_cylinder_predict_cost(&d);
-        core_s += r->t->seeds * c.particle_steps / predicted_rate;
-        *memory_mb = fmax(*memory_mb, c.memory_mb);
+        cal_bed_case b = cal_bed_case_make(r->c, r->t, stiffness[k], 1);
+        double memory = 0;
+        core_s += r->t->seeds * cal_bed_predict_particle_steps(&b, &memory) / predicted_rate;
+        *memory_mb = fmax(*memory_mb, memory);
     }
     return core_s;
 }

@@ -162,6 +162,16 @@ void cal_bed_key(const cal_bed_case *b, char *out, size_t len)
     snprintf(out, len, "drum_bed %s", def);
 }
 
+double cal_bed_predict_particle_steps(const cal_bed_case *b, double *memory_mb)
+{
+    if (b->on_drum) {
+        exp_drum_cost c = exp_drum_predict_cost(&b->drum_bed, 0);
+        return *memory_mb = c.memory_mb, c.fill_particle_steps;
+    }
+    exp_cylinder_cost c = exp_cylinder_predict_cost(&b->cylinder);
+    return *memory_mb = c.memory_mb, c.particle_steps;
+}
+
 // "[stage] what: status (reason), angle ..., CSA ... — T s simulated in W s; ENDING"
 static void show_record(const cal_env *env, const char *what, const cal_record *r, const char *ending)
 {

@@ -114,6 +114,11 @@ int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, i
 int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
                            cal_record *out, char *err, size_t len);
 
+/// What one stage-1 bed is expected to cost before it runs, in particle-steps,
+/// and its peak memory (MB): the cylinder's exp_cylinder_predict_cost, or the
+/// drum fill's (exp_drum_predict_cost).
+double cal_bed_predict_particle_steps(const cal_bed_case *b, double *memory_mb);
+
 /// Records of stage-1 beds, running the missing ones side by side.
 int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record *out, char *err, size_t len);
 
