@@ -135,10 +135,23 @@ static int blank_or_comment(const char *line)
     return *line == '#' || *line == '\n' || *line == '\0';
 }
 
+// A comment line that says the numbers are synthetic, and at what lambda.
+static void read_provenance(const char *line, cal_provenance *p)
+{
+    while (*line == ' ' || *line == '\t' || *line == '#') line++;
+    if (strncmp(line, "SYNTHETIC", 9) != 0) return;
+    p->synthetic = 1;
+    const char *at = strstr(line, "lambda ");
+    char *end = NULL;
+    double lambda = at ? strtod(at + 7, &end) : NAN;
+    if (at && end != at + 7 && lambda > 0 && !isfinite(p->lambda)) p->lambda = lambda;
+}
+
 int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *err, size_t len)
 {
     memset(s, 0, sizeof *s);
     snprintf(s->path, sizeof s->path, "%s", path);
+    s->provenance.lambda = NAN;
     FILE *f = fopen(path, "r");
     if (!f) return exp_fail(err, len, "%s: cannot open: %s", path, strerror(errno));
     struct csv_parser p;
@@ -157,7 +170,10 @@ int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *e
             fail_at(&r, "row", "%s", "contains a NUL byte: not a text file");
             break;
         }
-        if (blank_or_comment(line)) continue;
+        if (blank_or_comment(line)) {
+            read_provenance(line, &s->provenance);
+            continue;
+        }
         if (csv_parse(&p, line, (size_t)n, on_field, on_row, &r) != (size_t)n && !r.failed)
             fail_at(&r, "row", "malformed CSV (%s)", csv_strerror(csv_error(&p)));
         if (!r.failed && line[n - 1] != '\n') csv_fini(&p, on_field, on_row, &r);

@@ -17,10 +17,19 @@ typedef struct cal_point {
     int line;         ///< line in the file, for messages
 } cal_point;
 
+/// Where the numbers came from, as the file's comments say: a comment line
+/// beginning "SYNTHETIC" marks numbers made by a simulation, not measured
+/// (granucal synthesize, experiments/data/make_synthetic_csa.sh).
+typedef struct cal_provenance {
+    int synthetic;
+    double lambda; ///< the "lambda N" such a line names (NAN: none)
+} cal_provenance;
+
 typedef struct cal_series {
     char path[1024];
     cal_point *points;
     size_t count;
+    cal_provenance provenance;
 } cal_series;
 
 typedef enum cal_data_kind { CAL_DATA_ANGLE, CAL_DATA_CSA } cal_data_kind;

@@ -24,4 +24,18 @@ int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, char *e
 /// candidates). `bounds` is the search's rectangle. 0 on success, else 1.
 int cal_figures_friction(const char *dir, const cal_bounds *bounds, const cal_friction_result *r, char *err, size_t len);
 
+/// The x axis of a CSA-against-speed figure of n_series series at the n
+/// speeds rpm[]: [lo, hi] (the speeds and 5 % each side; one speed: ±2 rpm
+/// around it), `step`, the fraction of the axis between series drawn side by
+/// side at a speed so that their error bars stay apart (0 for one series),
+/// and widest_shift, the largest shift in rpm (cal_figures_dodge).
+typedef struct cal_speed_axis {
+    double lo, hi, step, widest_shift;
+} cal_speed_axis;
+cal_speed_axis cal_figures_speed_axis(int n, const double *rpm, int n_series);
+
+/// Series k's shift at each speed, in fractions of the axis: 0, -step, +step,
+/// -2 step, ... (the first series, the data, in the middle).
+double cal_figures_dodge(int k, double step);
+
 #endif
