@@ -62,12 +62,15 @@ static const char *stage_name(const cal_friction_result *r)
     return r->material[0] ? r->material : "granule";
 }
 
-// What the data files are, for a legend: "lab data", or "synthetic data (λ 512)".
-static void data_name(const cal_provenance *p, char *out, size_t len)
+// What the data files are, for a legend: "data (EXTRA)", or where the file
+// says its numbers are synthetic "synthetic data (λ 512; EXTRA)".
+static void data_label(const cal_provenance *p, const char *extra, char *out, size_t len)
 {
-    if (!p->synthetic) snprintf(out, len, "data");
-    else if (isfinite(p->lambda) && p->lambda > 0) snprintf(out, len, "synthetic data (λ %g)", p->lambda);
-    else snprintf(out, len, "synthetic data");
+    char lambda[48] = "";
+    if (p->synthetic && isfinite(p->lambda) && p->lambda > 0) snprintf(lambda, sizeof lambda, "λ %g", p->lambda);
+    const char *sep = lambda[0] && extra ? "; " : "";
+    if (!lambda[0] && !extra) snprintf(out, len, "%s", p->synthetic ? "synthetic data" : "data");
+    else snprintf(out, len, "%s (%s%s%s)", p->synthetic ? "synthetic data" : "data", lambda, sep, extra ? extra : "");
 }
 
 static int map_candidates(const cal_friction_result *r)
@@ -91,14 +94,14 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
     snprintf(path, sizeof path, "%s/angle_map_%s.png", dir, stage_name(r));
     snprintf(title, sizeof title, "%s: dynamic angle of repose at %g rpm (Fig. %s)", stage_name(r), r->angle_rpm,
              r->material[0] ? "17" : "13");
-    data_name(&r->angle_source, source, sizeof source);
-    snprintf(band, sizeof band, "target angle %.1f° ± %.1f° (%s)", r->angle_target, r->angle_tolerance, source);
+    data_label(&r->angle_source, NULL, source, sizeof source);
+    snprintf(band, sizeof band, "target angle %.1f° ± %.1f°, %s", r->angle_target, r->angle_tolerance, source);
     // A two-tier stage's map candidates are the cheap tier's runs with the
     // correction measured here added: predicted, not evaluated at this tier.
     if (mapped) snprintf(evaluated, sizeof evaluated, "runs at this tier (%d)", r->n - mapped);
     else snprintf(evaluated, sizeof evaluated, "evaluated candidates (%d)", r->n);
-    snprintf(mapped_label, sizeof mapped_label, "map tier%s%s runs + measured correction (%d; predicted, not run here)",
-             r->map_tier[0] ? " " : "", r->map_tier, mapped);
+    snprintf(mapped_label, sizeof mapped_label, "map tier '%s' runs + measured correction (%d; predicted, not run here)",
+             r->map_tier, mapped);
     if (r->best >= 0)
         snprintf(chosen, sizeof chosen, "chosen: μs = %.3g, μr = %.3g", r->cand[r->best].mu_s, r->cand[r->best].mu_r);
     exp_plot_map m = {.title = title, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
@@ -158,8 +161,8 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
     if (d->map_points)
         snprintf(title, sizeof title, "%s: search convergence (%d runs at this tier)", stage_name(r), d->runs);
     else snprintf(title, sizeof title, "%s: search convergence (%d evaluations)", stage_name(r), d->runs);
-    snprintf(map_label, sizeof map_label, "map tier%s%s runs + measured correction (%d, at 0: not run here, never chosen)",
-             r->map_tier[0] ? " " : "", r->map_tier, d->map_points);
+    snprintf(map_label, sizeof map_label, "map tier '%s' runs + measured correction (%d, at 0: not run here, never chosen)",
+             r->map_tier, d->map_points);
     size_t n = (size_t)d->runs, ns = 0;
     exp_plot_series s[5];
     s[ns++] = points(n, d->index, d->matching, "run matching the angle", blue, EXP_MARK_CIRCLE);
@@ -242,9 +245,7 @@ static int csa_vs_rpm(const char *dir, const cal_friction_result *r, char *err, 
         exp_plot_colour(j + 2, s[ns++].rgb); // palette 0 and 1 are blue and red: the data and the chosen
     }
     // The data last, over the candidates, and in the middle at each speed (the others a little aside).
-    char source[64];
-    data_name(&r->csa_source, source, sizeof source);
-    snprintf(labels[0], sizeof labels[0], "%s (bars: sd)", source);
+    data_label(&r->csa_source, "bars: sd", labels[0], sizeof labels[0]);
     s[ns++] = (exp_plot_series){.n = n_rpm, .x = r->rpm, .y = r->csa_data, .err = r->csa_data_sd,
                                 .label = labels[0], .rgb = {0, 0, 0}, .style = EXP_PLOT_POINTS,
                                 .marker = EXP_MARK_OPEN_SQUARE};

@@ -447,6 +447,27 @@ static void write_speeds_table(FILE *o, const study *s)
     }
 }
 
+// What the rungs run differ in, for the figure of the first speed: the scale
+// factor, or where every rung has one λ, the slice depth (a slice-depth study).
+static int against_depth(const study *s)
+{
+    double lambda = NAN, depth = NAN;
+    int depths_differ = 0;
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        if (isfinite(lambda) && r->rung->lambda != lambda) return 0;
+        depths_differ |= isfinite(depth) && r->depth != depth;
+        lambda = r->rung->lambda, depth = r->depth;
+    }
+    return depths_differ;
+}
+
+static const char *versus_file(const study *s)
+{
+    return against_depth(s) ? "fidelity_vs_slice_depth.png" : "fidelity_vs_lambda.png";
+}
+
 static int write_markdown(const study *s, const char *command, double wall, char *err, size_t len)
 {
     const cal_fidelity *f = s->c->fidelity;
@@ -503,8 +524,8 @@ static int write_markdown(const study *s, const char *command, double wall, char
             fprintf(o, "| %g (%s, %g rpm) | %.2f | %.2f |\n", s->res[i].rung->lambda, s->res[i].rung->name, f->rpm[0],
                     s->res[i].angle[0], s->res[i].csa[0]);
     fprintf(o, "\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
-               "`fidelity_vs_lambda.png`%s.\n",
-            f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
+               "`%s`%s.\n",
+            versus_file(s), f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
     return cal_atomic_commit(&a, err, len);
 }
 
@@ -514,7 +535,8 @@ typedef struct rung_points {
     double cost[MAX_RUNGS], angle_error[MAX_RUNGS], csa_error[MAX_RUNGS]; ///< all but the finest
     const char *name[MAX_RUNGS];
     int m;
-    double lambda[MAX_RUNGS], angle[MAX_RUNGS], angle_sd[MAX_RUNGS], csa[MAX_RUNGS], csa_sd[MAX_RUNGS];
+    double lambda[MAX_RUNGS], depth_mm[MAX_RUNGS], angle[MAX_RUNGS], angle_sd[MAX_RUNGS], csa[MAX_RUNGS],
+        csa_sd[MAX_RUNGS];
     const char *rung_of[MAX_RUNGS];
 } rung_points;
 
@@ -524,7 +546,8 @@ static void collect_rungs(const study *s, rung_points *p)
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
         if (!r->ran) continue;
-        p->lambda[p->m] = r->rung->lambda, p->angle[p->m] = r->angle[0], p->csa[p->m] = r->csa[0];
+        p->lambda[p->m] = r->rung->lambda, p->depth_mm[p->m] = 1e3 * r->depth;
+        p->angle[p->m] = r->angle[0], p->csa[p->m] = r->csa[0];
         p->angle_sd[p->m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
         p->csa_sd[p->m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0;
         p->rung_of[p->m++] = r->rung->name;
@@ -553,29 +576,36 @@ static int plot_error_vs_cost(const study *s, const rung_points *p, char *err, s
     return exp_plot_png(path, &axes, 2, v, 1000, 640, err, len);
 }
 
-// The first speed's angle and CSA against λ, beside the paper's Table B.1.
+// The first speed's angle and CSA against λ, or against the slice depth where
+// every rung has one λ; beside the paper's Table B.1 (λ 8, 27, 64, its drum at
+// 4 rpm) on a λ axis at 4 rpm only.
 static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_t len)
 {
-    double b1_l[3], b1_a[3], b1_c[3];
+    double b1_l[3], b1_a[3], b1_c[3], rpm = s->c->fidelity->rpm[0];
     for (int k = 0; k < 3; ++k)
         b1_l[k] = table_b1[k].lambda, b1_a[k] = table_b1[k].angle_deg, b1_c[k] = table_b1[k].csa_percent;
+    int depth = against_depth(s), with_b1 = !depth && rpm == 4;
     size_t m = (size_t)p->m;
+    const double *x = depth ? p->depth_mm : p->lambda;
     exp_plot_series v[4] = {
-        {.n = m, .x = p->lambda, .y = p->angle, .err = p->angle_sd, .names = p->rung_of,
+        {.n = m, .x = x, .y = p->angle, .err = p->angle_sd, .names = p->rung_of,
          .label = "angle, granucal (bars: seed sd)",
          .rgb = {0.84, 0.15, 0.16}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_CIRCLE},
-        {.n = m, .x = p->lambda, .y = p->csa, .err = p->csa_sd, .label = "CSA, granucal (bars: seed sd)",
+        {.n = m, .x = x, .y = p->csa, .err = p->csa_sd, .label = "CSA, granucal (bars: seed sd)",
          .rgb = {0.12, 0.40, 0.75}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_SQUARE},
-        {.n = 3, .x = b1_l, .y = b1_a, .label = "angle, paper's Table B.1", .rgb = {0.95, 0.6, 0.5},
+        {.n = 3, .x = b1_l, .y = b1_a, .label = "angle, paper's Table B.1 (4 rpm)", .rgb = {0.95, 0.6, 0.5},
          .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_TRIANGLE, .dashed = 1},
-        {.n = 3, .x = b1_l, .y = b1_c, .label = "CSA, paper's Table B.1", .rgb = {0.5, 0.65, 0.95},
+        {.n = 3, .x = b1_l, .y = b1_c, .label = "CSA, paper's Table B.1 (4 rpm)", .rgb = {0.5, 0.65, 0.95},
          .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_DIAMOND, .dashed = 1},
     };
     char path[1200], title[160];
-    snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->report);
-    snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", s->c->fidelity->rpm[0]);
-    exp_plot_axes axes = {.title = title, .xlabel = "scale factor λ", .ylabel = "angle (°) / CSA (%)", .log_x = 1};
-    return exp_plot_png(path, &axes, 4, v, 1000, 640, err, len);
+    snprintf(path, sizeof path, "%s/%s", s->report, versus_file(s));
+    if (depth)
+        snprintf(title, sizeof title, "Angle and CSA against the slice depth (λ %g, %g rpm)", p->lambda[0], rpm);
+    else snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", rpm);
+    exp_plot_axes axes = {.title = title, .xlabel = depth ? "slice depth (mm; the drum's depth for a full drum)" : "scale factor λ",
+                          .ylabel = "angle (°) / CSA (%)", .log_x = !depth};
+    return exp_plot_png(path, &axes, with_b1 ? 4 : 2, v, 1000, 640, err, len);
 }
 
 // Each rung's angle and CSA against the drum's speed (a study of several
