@@ -176,8 +176,8 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
         s[ns++] = points((size_t)d->map_points, d->map_index, d->mapped, map_label, grey, EXP_MARK_OPEN_DIAMOND);
     exp_plot_axes axes = {.title = title,
                           .xlabel = d->map_points ? "run at this tier (0: the map tier's candidates, predicted)" : "evaluation",
-                          .ylabel = r->angle_in_misfit ? "objective: angle and CSA misfit (mean squared z)"
-                                                       : "objective: CSA misfit (mean squared z)",
+                          .ylabel = r->angle_in_misfit ? "angle and CSA misfit (mean squared z)"
+                                                       : "CSA misfit (mean squared z)",
                           .log_y = 1};
     int rc = exp_plot_png(path, &axes, ns, s, WIDTH, HEIGHT, err, len);
     free(d);

@@ -629,13 +629,22 @@ static void legend_add_band(legend *l, const char *text, int colour)
 // The notes a series' legend entry carries after its label.
 static char legend_notes[24][320];
 
+// Whether a series draws anything: an entry for a series with nothing drawn
+// would name what the figure does not show.
+static int draws_something(const exp_plot_series *s)
+{
+    for (size_t i = 0; i < s->n; ++i)
+        if (isfinite(s->y[i]) && (s->style == EXP_PLOT_HLINE || isfinite(s->x[i]))) return 1;
+    return 0;
+}
+
 // hidden[k]: series k's error bars are all shorter than its marker (NULL: none is).
 static void legend_of_series(legend *l, size_t ns, const exp_plot_series *s, const int *hidden)
 {
     *l = (legend){0};
     for (size_t k = 0; k < ns; ++k) {
         int points = s[k].style == EXP_PLOT_POINTS || s[k].style == EXP_PLOT_LINE_POINTS;
-        const char *text = s[k].label;
+        const char *text = draws_something(&s[k]) ? s[k].label : NULL;
         if (text && hidden && hidden[k] && l->n < 24) {
             snprintf(legend_notes[l->n], sizeof legend_notes[0], "%s: error bars shorter than the marker", text);
             text = legend_notes[l->n];

@@ -4,8 +4,8 @@
 /// device: charts of series on one pair of axes (lines, markers, error bars,
 /// a name beside each point, a labelled horizontal reference line, log axes)
 /// and filled maps of a quantity measured at scattered points of a plane.
-/// PLplot chooses the ticks; every labelled series gets a legend entry and an
-/// unlabelled one none.
+/// PLplot chooses the ticks; every labelled series with a point to draw gets a
+/// legend entry, an unlabelled or empty one none.
 ///
 /// PLplot's state is process-global: each call begins and ends its figure, so
 /// figures never interleave. Call from one thread only (never inside an
