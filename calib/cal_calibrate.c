@@ -308,13 +308,15 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
             *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
             return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
         }
-        *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)";
+        *k_n = r->stiffness.chosen_k, *source = "stage 1 (poured cylinder, Fig. 12)", r->table.k_calibrated = 1;
         return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
     }
     stage_file s;
     int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
     if (got < 0) return 1;
-    if (got) *k_n = s.k_n, *source = "stage 1, earlier run (stage_stiffness.yaml)";
+    // An unresolved sweep stores the config's k_n too: only a k_n unlike the
+    // config's is known to be stage 1's choice.
+    if (got) *k_n = s.k_n, *source = "stage 1, earlier run (stage_stiffness.yaml)", r->table.k_calibrated = s.k_n != r->c->k_n;
     return 0;
 }
 
@@ -356,6 +358,7 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
                                                "stage 2, best misfit (angle outside its tolerance)",
                                                "stage 2, closest (angle not matched)"};
         *source = friction_source(r->granule, sources);
+        r->table.gg_angle_matched = r->granule->cand[r->granule->best].angle_violation <= 0;
         const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
         return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
     }
@@ -364,6 +367,7 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
     if (got < 0) return 1;
     if (got) {
         *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
+        r->table.gg_angle_matched = -1;
         stage_ranges(&s, &r->table.gg_mu_s_range, &r->table.gg_mu_r_range);
     }
     return 0;
@@ -388,6 +392,7 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
                                                "stage 3, best misfit (angle outside its tolerance)",
                                                "stage 3, closest (angle not matched)"};
         snprintf(r->table.wall_source[t], 96, "%s", friction_source(w, sources));
+        r->table.wall_angle_matched[t] = w->cand[w->best].angle_violation <= 0;
     }
     return 0;
 }
@@ -509,6 +514,7 @@ static int calibrate(run *r, const char *command)
     if (cal_mpi_rank() != 0) return 0;
     cal_outcome o = {.config = r->c, .tier = r->t, .stiffness = wants(r, "stiffness") ? &r->stiffness : NULL,
                      .granule = r->granule, .n_walls = r->n_walls, .table = r->table, .command = command,
+                     .angle_data_synthetic = r->angles.synthetic, .csa_data_synthetic = r->areas.synthetic,
                      .wall_time_s = exp_wall_seconds() - r->env.started, .ranks = cal_mpi_size(), .workers = r->env.workers};
     for (int w = 0; w < r->n_walls; ++w) o.walls[w] = r->walls[w];
     if (cal_report_write(r->out, &o, r->err, sizeof r->err)) return 1;

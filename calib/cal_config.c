@@ -26,6 +26,7 @@ static const cyaml_schema_value_t material_entry = {CYAML_VALUE_MAPPING(CYAML_FL
 // A strict yes/no: libcyaml's bool reads any word but a few as true.
 static const cyaml_strval_t yes_no[] = {{"false", 0}, {"true", 1}, {"no", 0}, {"yes", 1}};
 static const cyaml_strval_t corrections[] = {{"kriging", CAL_MF_KRIGING}, {"affine", CAL_MF_AFFINE}};
+static const cyaml_strval_t purposes[] = {{"calibration", 0}, {"demonstration", 1}};
 
 #define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
 static const cyaml_schema_field_t tier_fields[] = {
@@ -58,6 +59,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_ENUM_PTR("map_correction", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, map_correction, corrections,
                          CYAML_ARRAY_LEN(corrections)),
     CYAML_FIELD_INT("beds", CYAML_FLAG_OPTIONAL, cal_tier, beds),
+    CYAML_FIELD_ENUM_PTR("purpose", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, demonstration, purposes,
+                         CYAML_ARRAY_LEN(purposes)),
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
@@ -281,6 +284,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
 int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
+int cal_tier_is_demonstration(const cal_tier *t) { return t->demonstration && *t->demonstration; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
 const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n)
 {

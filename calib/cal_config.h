@@ -81,12 +81,18 @@ typedef struct cal_tier {
     /// one bed's spreads, as measured; the search divides them by sqrt(beds)
     /// (independent packings). 0: one.
     int beds;
+    /// `purpose: demonstration` (1) marks a tier too coarse for its table to
+    /// stand for the powder: every output of its runs says "demonstration —
+    /// not a calibration of this powder". Absent or `calibration`: 0.
+    int *demonstration;
 } cal_tier;
 
 /// 1 if the tier puts the angle into the misfit instead of a constraint.
 int cal_tier_angle_in_misfit(const cal_tier *t);
 /// Beds per drum candidate (1 when not given).
 int cal_tier_beds(const cal_tier *t);
+/// 1 if the tier's purpose is demonstration (cal_tier.demonstration).
+int cal_tier_is_demonstration(const cal_tier *t);
 /// 1 if the tier probes the μr bounds after the search (the default).
 int cal_tier_bound_probes(const cal_tier *t);
 /// The tier's map_correction (kriging when absent).

@@ -4,7 +4,9 @@
 /// row by row before any simulation starts:
 ///   repose_angle.csv   surface,rpm,angle_deg,angle_sd_deg   (Table 2)
 ///   occupied_area.csv  surface,rpm,csa_percent,csa_sd_percent (eq. 20)
-/// Lines starting with '#' are comments (provenance, units).
+/// Lines starting with '#' are comments (provenance, units). A comment line
+/// holding the word SYNTHETIC (as `granucal synthesize` writes) marks the
+/// file as simulated, not measured: every output then says so.
 #ifndef CAL_DATA_H
 #define CAL_DATA_H
 
@@ -17,20 +19,20 @@ typedef struct cal_point {
     int line;         ///< line in the file, for messages
 } cal_point;
 
-/// Where the numbers came from, as the file's comments say: a comment line
-/// beginning "SYNTHETIC" marks numbers made by a simulation, not measured
-/// (granucal synthesize, experiments/data/make_synthetic_csa.sh).
-typedef struct cal_provenance {
-    int synthetic;
-    double lambda; ///< the "lambda N" such a line names (NAN: none)
-} cal_provenance;
-
 typedef struct cal_series {
     char path[1024];
     cal_point *points;
     size_t count;
-    cal_provenance provenance;
+    int synthetic;    ///< 1 if a comment line says SYNTHETIC: simulated data, not the lab's
+    double synthetic_lambda; ///< the scale factor "lambda N" a SYNTHETIC line names (NAN: none)
 } cal_series;
+
+/// What a figure says of a data file's numbers (cal_series.synthetic and
+/// synthetic_lambda), kept with the stage's result.
+typedef struct cal_provenance {
+    int synthetic;
+    double lambda; ///< NAN: not named
+} cal_provenance;
 
 typedef enum cal_data_kind { CAL_DATA_ANGLE, CAL_DATA_CSA } cal_data_kind;
 

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cal_status.h"
 #include "cal_util.h"
 #include "dem_gsd.h"
 #include "exp_common.h"
@@ -41,6 +42,17 @@ static void write_differences(FILE *f, const char *const *items, const char *bul
         }
         fputc('\n', f);
     }
+}
+
+// What the table is and which of its values the data did not choose, as
+// comment lines: the export is what a user copies, so it must say it.
+static void write_status(FILE *f, const cal_outcome *o)
+{
+    cal_run_status rs = cal_run_status_of(o);
+    cal_run_status_banner(f, &rs, "# ");
+    long before = ftell(f);
+    cal_table_caveats(f, o, "# NOT CALIBRATED: ");
+    if (ftell(f) == before) fputs("# Every friction below was chosen by the data.\n", f);
 }
 
 // The paper's dashpot is γ_n = 2ξ sqrt(m* k) (eq. 5); LIGGGHTS' hooke/stiffness
@@ -94,7 +106,9 @@ static int write_liggghts(const char *dir, const cal_outcome *o, char *err, size
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     int n = 1 + t->n_walls;
-    fprintf(f, "# granucal %s: calibrated parameters for LIGGGHTS 3.8.\n# atom type 1 = granules", exp_version());
+    fprintf(f, "# granucal %s: the table's parameters for LIGGGHTS 3.8.\n", exp_version());
+    write_status(f, o);
+    fputs("# atom type 1 = granules", f);
     for (int w = 0; w < t->n_walls; ++w) fprintf(f, ", %d = %s wall", w + 2, t->wall_name[w]);
     fputs(" (a wall: fix wall/gran ... primitive type N, same model keywords)\n# Differences from the paper's model:\n", f);
     write_differences(f, liggghts_differences, "#  - ", "#    ");
@@ -128,8 +142,9 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
-    fprintf(f, "# granucal %s: calibrated parameters for LAMMPS pair_style granular.\n"
-               "# Differences from the paper's model:\n", exp_version());
+    fprintf(f, "# granucal %s: the table's parameters for LAMMPS pair_style granular.\n", exp_version());
+    write_status(f, o);
+    fputs("# Differences from the paper's model:\n", f);
     write_differences(f, lammps_differences, "#  - ", "#    ");
     fputs("# Walls: fix ID all wall/gran/region granular ${wall_<material>} region R\n", f);
     write_scaling(f, t);

@@ -72,6 +72,28 @@ void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, dou
     }
 }
 
+double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double v)
+{
+    if (!c || c->n_runs < 2 || !(c->scale[k] > 0)) return 0;
+    const size_t m = (size_t)c->n_runs;
+    gsl_matrix *K = gsl_matrix_alloc(m, m);
+    gsl_vector *kx = gsl_vector_alloc(m), *a = gsl_vector_alloc(m);
+    double var = 1; // the kernel at zero distance
+    if (K && kx && a) {
+        for (size_t i = 0; i < m; ++i) {
+            gsl_vector_set(kx, i, kernel(u, v, c->run_u[i], c->run_v[i]));
+            for (size_t j = 0; j < m; ++j)
+                gsl_matrix_set(K, i, j, kernel(c->run_u[i], c->run_v[i], c->run_u[j], c->run_v[j]) + (i == j ? c->nugget[k] : 0));
+        }
+        gsl_error_handler_t *old = gsl_set_error_handler_off();
+        if (!gsl_linalg_cholesky_decomp1(K) && !gsl_linalg_cholesky_solve(K, kx, a))
+            for (size_t i = 0; i < m; ++i) var -= gsl_vector_get(kx, i) * gsl_vector_get(a, i);
+        gsl_set_error_handler(old);
+    }
+    gsl_matrix_free(K), gsl_vector_free(kx), gsl_vector_free(a);
+    return c->scale[k] * sqrt(fmax(var, 0));
+}
+
 void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y)
 {
     double x[CAL_MF_TERMS];
@@ -176,6 +198,7 @@ static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], cons
         int bad = gsl_linalg_cholesky_decomp1(K) || gsl_linalg_cholesky_solve(K, r, w);
         gsl_set_error_handler(old);
         for (int i = 0; i < m; ++i) c->weight[k][i] = bad ? 0 : gsl_vector_get(w, (size_t)i);
+        c->scale[k] = bad ? 0 : scale, c->nugget[k] = fmax(ratio, 1e-9);
     }
     gsl_matrix_free(K), gsl_vector_free(r), gsl_vector_free(w);
 }

@@ -67,10 +67,21 @@ typedef struct cal_mf_correction {
     int n_runs; ///< runs carrying kernel weights (0: the plane alone)
     double run_u[CAL_MF_MAX_FINE], run_v[CAL_MF_MAX_FINE];
     double weight[CAL_MF_MAX_Y][CAL_MF_MAX_FINE];
+    /// The kriging's scale (the residuals' rms, at least the runs' noise) and
+    /// nugget ratio per measurement, for its variance (cal_mf_correction_sd);
+    /// scale 0: no kriging (the plane alone, or a system GSL could not factor).
+    double scale[CAL_MF_MAX_Y], nugget[CAL_MF_MAX_Y];
 } cal_mf_correction;
 
 /// Add the correction at (u, v) to y (n_y measurements); c NULL: nothing.
 void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, double *y);
+
+/// The kriging's own standard deviation of measurement k's correction at
+/// (u, v): scale·sqrt(1 − kᵀ(K + nugget·I)⁻¹k), near 0 at a run (up to its
+/// noise) and the scale far from every run. 0 where there is no kriging (c
+/// NULL, fewer than two runs, or scale 0): the plane alone carries no
+/// variance model.
+double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double v);
 
 /// What the stage gives the loop.
 typedef struct cal_mf_problem {

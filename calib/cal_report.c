@@ -10,62 +10,88 @@
 
 #include "cal_export.h"
 #include "cal_figures.h"
+#include "cal_posterior.h"
+#include "cal_status.h"
 #include "cal_util.h"
 #include "exp_common.h"
 #include "exp_contact_rules.h"
 
 // ---- the table ---------------------------------------------------------------
 
-typedef struct row {
-    const char *contact;
-    char material[32];
-    const char *parameter;
-    double value;
-    const char *unit;
-    cal_range range; ///< identified range of a calibrated friction; NAN otherwise
-} row;
+// ---- the posteriors -------------------------------------------------------------
 
-static const cal_range no_range = CAL_NO_RANGE_INIT;
+// Each friction stage run now, its posterior (cal_posterior.h): [0] the
+// granule stage, [1 + w] wall w. ok 0: not run now (read from a stage file),
+// or no map to sample (why says so).
+typedef struct posteriors {
+    cal_posterior of[17];
+    int ok[17];
+    char why[17][200];
+} posteriors;
 
-static int table_rows(const cal_table *t, row *rows)
+static const cal_friction_result *stage_of(const cal_outcome *o, int i) { return i == 0 ? o->granule : o->walls[i - 1]; }
+
+static void posteriors_sample(const cal_outcome *o, posteriors *p)
 {
-    int n = 0;
-    const char *names[] = {"k_n", "k_s", "k_r"};
-    rows[n++] = (row){"granule-granule", "", "density", t->density, "kg/m3", no_range};
-    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-granule", "", names[k], t->k_n, "N/m", no_range};
-    rows[n++] = (row){"granule-granule", "", "xi", t->xi, "-", no_range};
-    rows[n++] = (row){"granule-granule", "", "mu_s", t->gg_mu_s, "-", t->gg_mu_s_range};
-    rows[n++] = (row){"granule-granule", "", "mu_r", t->gg_mu_r, "-", t->gg_mu_r_range};
-    const double k_boundary = exp_boundary_stiffness(t->k_n);
-    for (int k = 0; k < 3; ++k) rows[n++] = (row){"granule-boundary", "", names[k], k_boundary, "N/m", no_range};
-    rows[n++] = (row){"granule-boundary", "", "xi", t->xi, "-", no_range};
-    for (int w = 0; w < t->n_walls; ++w) {
-        rows[n] = (row){"granule-boundary", "", "mu_s", t->wall_mu_s[w], "-", t->wall_mu_s_range[w]};
-        snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
-        rows[n] = (row){"granule-boundary", "", "mu_r", t->wall_mu_r[w], "-", t->wall_mu_r_range[w]};
-        snprintf(rows[n++].material, 32, "%s", t->wall_name[w]);
+    memset(p, 0, sizeof *p);
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+        const cal_friction_result *r = stage_of(o, i);
+        if (r)
+            p->ok[i] = !cal_posterior_sample(r, i ? &o->config->wall : &o->config->granule, &p->of[i], p->why[i],
+                                             sizeof p->why[i]);
     }
-    return n;
 }
 
-static int write_table_csv(const char *dir, const row *rows, int n, char *err, size_t len)
+static void posteriors_free(posteriors *p)
 {
-    char path[1200];
+    for (int i = 0; i < 17; ++i) cal_posterior_free(&p->of[i]);
+}
+
+// The posterior of a table row's friction, or NULL.
+static const cal_posterior *row_posterior(const cal_outcome *o, const posteriors *p, const cal_table_row *row, int *param)
+{
+    *param = !strcmp(row->parameter, "mu_r");
+    if (strcmp(row->parameter, "mu_s") && !*param) return NULL;
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+        const cal_friction_result *r = stage_of(o, i);
+        if (r && p->ok[i] && !strcmp(r->material, row->material)) return &p->of[i];
+    }
+    return NULL;
+}
+
+static int write_table_csv(const char *dir, const cal_outcome *o, const posteriors *post, const cal_table_row *rows,
+                           int n, char *err, size_t len)
+{
+    char path[1200], data[64];
     snprintf(path, sizeof path, "%s/calibrated_parameters.csv", dir);
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     // identified_min/max: the range of the candidates the data cannot tell
     // apart (cal_friction_identify); not_excluded_min/max: its bracket, the
     // interval no evaluated candidate excludes (cal_range); empty where
-    // nothing was calibrated.
-    fputs("contact,material,parameter,value,unit,identified_min,identified_max,not_excluded_min,not_excluded_max\n", a.f);
+    // nothing was calibrated. posterior_median, credible_min/max: the
+    // posterior's median and 95 % credible interval (cal_posterior.h), empty
+    // where the stage did not run now. status and flags: what the value is
+    // (cal_status.h); tier, lambda, data and purpose: what the run is, on
+    // every row, so that no comment line is needed and a row copied alone
+    // still says it.
+    cal_run_status rs = cal_run_status_of(o);
+    cal_run_data_text(data, sizeof data, &rs);
+    fputs("contact,material,parameter,value,unit,identified_min,identified_max,not_excluded_min,not_excluded_max,"
+          "status,flags,tier,lambda,data,purpose,posterior_median,credible_min,credible_max\n", a.f);
     for (int i = 0; i < n; ++i) {
         const cal_range *g = &rows[i].range;
         fprintf(a.f, "%s,%s,%s,%.6g,%s,", rows[i].contact, rows[i].material, rows[i].parameter, rows[i].value, rows[i].unit);
         if (isfinite(g->lo)) fprintf(a.f, "%.6g,%.6g,", g->lo, g->hi);
         else fputs(",,", a.f);
-        if (isfinite(g->bracket_lo)) fprintf(a.f, "%.6g,%.6g\n", g->bracket_lo, g->bracket_hi);
-        else fputs(",\n", a.f);
+        if (isfinite(g->bracket_lo)) fprintf(a.f, "%.6g,%.6g,", g->bracket_lo, g->bracket_hi);
+        else fputs(",,", a.f);
+        fprintf(a.f, "%s,%s,%s,%g,%s,%s,", cal_value_status_name(rows[i].verdict.status), rows[i].verdict.flags,
+                rs.tier, rs.drum_lambda, data, cal_run_purpose(&rs));
+        int p;
+        const cal_posterior *q = row_posterior(o, post, &rows[i], &p);
+        if (q) fprintf(a.f, "%.6g,%.6g,%.6g\n", q->median[p], q->lo[p], q->hi[p]);
+        else fputs(",,\n", a.f);
     }
     return cal_atomic_commit(&a, err, len);
 }
@@ -84,60 +110,156 @@ static const char *range_cell(char out[160], cal_range g, double value)
     return out;
 }
 
-static int write_table_md(const char *dir, const cal_table *t, char *err, size_t len)
+static const cal_table_row *find_row(const cal_table_row *rows, int n, const char *contact, const char *material,
+                                     const char *parameter)
 {
+    for (int i = 0; i < n; ++i)
+        if (!strcmp(rows[i].contact, contact) && !strcmp(rows[i].material, material) &&
+            !strcmp(rows[i].parameter, parameter))
+            return &rows[i];
+    return NULL;
+}
+
+// The value as a person reads it, with what the search ended at where the
+// data did not choose it.
+static const char *value_cell(char out[160], const cal_table_row *r)
+{
+    char text[48];
+    cal_verdict_value_text(text, sizeof text, r->value, &r->verdict);
+    if (r->verdict.status == CAL_VALUE_NOT_IDENTIFIED)
+        snprintf(out, 160, "%s (any in %.3g – %.3g; the search ended at %.3g)", text, r->range.bracket_lo,
+                 r->range.bracket_hi, r->value);
+    else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
+        snprintf(out, 160, "%s (the search stopped on its bound %.3g)", text, r->value);
+    else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
+        snprintf(out, 160, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
+    else snprintf(out, 160, "%s", text);
+    return out;
+}
+
+typedef struct md_table {
+    FILE *f;
+    const cal_outcome *o;
+    const posteriors *post;
+} md_table;
+
+// The posterior's median and 95 % credible interval of a friction row, or "".
+static const char *posterior_cell(char out[96], const md_table *t, const cal_table_row *r)
+{
+    int p;
+    const cal_posterior *q = row_posterior(t->o, t->post, r, &p);
+    if (!q) return out[0] = '\0', out;
+    snprintf(out, 96, "%.3g [%.3g – %.3g]%s", q->median[p], q->lo[p], q->hi[p],
+             q->reaches_lower[p] && q->reaches_upper[p] ? " (both bounds)"
+             : q->reaches_lower[p]                     ? " (to the lower bound)"
+             : q->reaches_upper[p]                     ? " (to the upper bound)"
+                                                       : "");
+    return out;
+}
+
+// One row of the Markdown table: label, material, value, status and flags, range, posterior, source.
+static void md_row(const md_table *t, const char *contact, const char *label, const cal_table_row *r, const char *source)
+{
+    char value[160], range[160], posterior[96];
+    fprintf(t->f, "| %s | %s | %s | %s | %s%s%s%s | %s | %s | %s |\n", contact, label, r->material, value_cell(value, r),
+            cal_value_status_name(r->verdict.status), r->verdict.flags[0] ? " (" : "", r->verdict.flags,
+            r->verdict.flags[0] ? ")" : "", range_cell(range, r->range, r->value), posterior_cell(posterior, t, r),
+            source);
+}
+
+static int write_table_md(const char *dir, const cal_outcome *o, const posteriors *post, const cal_table_row *rows,
+                          int n, char *err, size_t len)
+{
+    const cal_table *t = &o->table;
     char path[1200];
     snprintf(path, sizeof path, "%s/calibrated_parameters.md", dir);
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
-    char g[2][160];
-    fputs("| Contact | Parameter | Material | Value | Identified range (95 %) | Source |\n|---|---|---|---|---|---|\n", f);
-    fprintf(f, "| Granule–granule | Granule density ρ_g (kg/m³) | | %g | | config |\n", t->density);
-    fprintf(f, "| | Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m) | | %g | | %s |\n", t->k_n, t->k_source);
-    fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
-    fprintf(f, "| | Sliding friction μs,g-g | | %.3g | %s | %s |\n", t->gg_mu_s, range_cell(g[0], t->gg_mu_s_range, t->gg_mu_s), t->gg_source);
-    fprintf(f, "| | Rolling friction μr,g-g | | %.3g | %s | %s |\n", t->gg_mu_r, range_cell(g[1], t->gg_mu_r_range, t->gg_mu_r), t->gg_source);
-    fprintf(f, "| Granule–boundary | k_n = k_s = k_r (N/m) | | %g | | 2 k_n, springs in series (Table 3) |\n",
-            exp_boundary_stiffness(t->k_n));
-    fprintf(f, "| | Damping ratio ξ | | %g | | config |\n", t->xi);
+    cal_run_status rs = cal_run_status_of(o);
+    cal_run_status_banner(f, &rs, "> ");
+    fputs("\n| Contact | Parameter | Material | Value | Status | Identified range (95 %) | Posterior median [95 % "
+          "credible] | Source |\n|---|---|---|---|---|---|---|---|\n", f);
+    const md_table m = {f, o, post};
+    const char *gg = "granule-granule", *gw = "granule-boundary";
+    md_row(&m, "Granule–granule", "Granule density ρ_g (kg/m³)", find_row(rows, n, gg, "", "density"), "config");
+    md_row(&m, "", "Normal, tangential, rolling stiffness k_n = k_s = k_r (N/m)", find_row(rows, n, gg, "", "k_n"),
+           t->k_source);
+    md_row(&m, "", "Damping ratio ξ", find_row(rows, n, gg, "", "xi"), "config");
+    md_row(&m, "", "Sliding friction μs,g-g", find_row(rows, n, gg, "", "mu_s"), t->gg_source);
+    md_row(&m, "", "Rolling friction μr,g-g", find_row(rows, n, gg, "", "mu_r"), t->gg_source);
+    md_row(&m, "Granule–boundary", "k_n = k_s = k_r (N/m)", find_row(rows, n, gw, "", "k_n"),
+           "2 k_n, springs in series (Table 3)");
+    md_row(&m, "", "Damping ratio ξ", find_row(rows, n, gw, "", "xi"), "config");
     for (int w = 0; w < t->n_walls; ++w)
-        fprintf(f, "| | Sliding friction μs,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_s[w],
-                range_cell(g[0], t->wall_mu_s_range[w], t->wall_mu_s[w]), t->wall_source[w]);
+        md_row(&m, "", "Sliding friction μs,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_s"), t->wall_source[w]);
     for (int w = 0; w < t->n_walls; ++w)
-        fprintf(f, "| | Rolling friction μr,g-s | %s | %.3g | %s | %s |\n", t->wall_name[w], t->wall_mu_r[w],
-                range_cell(g[1], t->wall_mu_r_range[w], t->wall_mu_r[w]), t->wall_source[w]);
+        md_row(&m, "", "Rolling friction μr,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_r"), t->wall_source[w]);
     return cal_atomic_commit(&a, err, len);
 }
 
 typedef struct h5_row {
-    char contact[24], material[32], parameter[16], unit[8];
+    char contact[24], material[32], parameter[16], unit[8], status[16], flags[192];
     double value, identified_min, identified_max; ///< NaN: not calibrated
 } h5_row;
 
-static int write_table_h5(const char *dir, const row *rows, int n, char *err, size_t len)
+// A string attribute of the file's root: what the run is.
+static int h5_root_string(hid_t file, const char *name, const char *value)
+{
+    hid_t type = H5Tcopy(H5T_C_S1), space = H5Screate(H5S_SCALAR);
+    H5Tset_size(type, strlen(value) + 1);
+    hid_t attr = H5Acreate2(file, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+    int bad = attr < 0 || H5Awrite(attr, type, value) < 0;
+    if (attr >= 0) H5Aclose(attr);
+    H5Sclose(space);
+    H5Tclose(type);
+    return bad;
+}
+
+static int h5_run_status(hid_t file, const cal_outcome *o)
+{
+    cal_run_status rs = cal_run_status_of(o);
+    char data[64], lambda[32], cylinder[32];
+    snprintf(lambda, sizeof lambda, "%g", rs.drum_lambda);
+    snprintf(cylinder, sizeof cylinder, "%g", rs.cylinder_lambda);
+    return h5_root_string(file, "purpose", cal_run_purpose(&rs)) || h5_root_string(file, "tier", rs.tier) ||
+           h5_root_string(file, "lambda", lambda) || h5_root_string(file, "cylinder_lambda", cylinder) ||
+           h5_root_string(file, "data", cal_run_data_text(data, sizeof data, &rs)) ||
+           h5_root_string(file, "granucal", exp_version());
+}
+
+static void h5_rows(const cal_table_row *rows, int n, h5_row *data)
+{
+    for (int i = 0; i < n; ++i) {
+        snprintf(data[i].contact, sizeof data[i].contact, "%s", rows[i].contact);
+        snprintf(data[i].material, sizeof data[i].material, "%s", rows[i].material);
+        snprintf(data[i].parameter, sizeof data[i].parameter, "%s", rows[i].parameter);
+        snprintf(data[i].unit, sizeof data[i].unit, "%s", rows[i].unit);
+        snprintf(data[i].status, sizeof data[i].status, "%s", cal_value_status_name(rows[i].verdict.status));
+        snprintf(data[i].flags, sizeof data[i].flags, "%s", rows[i].verdict.flags);
+        data[i].value = rows[i].value;
+        data[i].identified_min = rows[i].range.lo, data[i].identified_max = rows[i].range.hi;
+    }
+}
+
+static int write_table_h5(const char *dir, const cal_outcome *o, const cal_table_row *rows, int n, char *err,
+                          size_t len)
 {
     char path[1200], tmp[1300];
     snprintf(path, sizeof path, "%s/calibrated_parameters.h5", dir);
     cal_temporary_name(path, tmp, sizeof tmp);
     h5_row *data = calloc((size_t)n, sizeof *data);
     if (!data) return exp_fail(err, len, "out of memory");
-    for (int i = 0; i < n; ++i) {
-        snprintf(data[i].contact, sizeof data[i].contact, "%s", rows[i].contact);
-        snprintf(data[i].material, sizeof data[i].material, "%s", rows[i].material);
-        snprintf(data[i].parameter, sizeof data[i].parameter, "%s", rows[i].parameter);
-        snprintf(data[i].unit, sizeof data[i].unit, "%s", rows[i].unit);
-        data[i].value = rows[i].value;
-        data[i].identified_min = rows[i].range.lo, data[i].identified_max = rows[i].range.hi;
-    }
+    h5_rows(rows, n, data);
     hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     hid_t type = H5Tcreate(H5T_COMPOUND, sizeof(h5_row));
-    size_t sizes[4] = {24, 32, 16, 8};
-    size_t offsets[4] = {offsetof(h5_row, contact), offsetof(h5_row, material), offsetof(h5_row, parameter),
-                         offsetof(h5_row, unit)};
-    const char *names[4] = {"contact", "material", "parameter", "unit"};
-    hid_t strings[4];
-    for (int k = 0; k < 4; ++k) {
+    enum { N_STRINGS = 6 };
+    size_t sizes[N_STRINGS] = {24, 32, 16, 8, 16, 192};
+    size_t offsets[N_STRINGS] = {offsetof(h5_row, contact), offsetof(h5_row, material), offsetof(h5_row, parameter),
+                                 offsetof(h5_row, unit),    offsetof(h5_row, status),   offsetof(h5_row, flags)};
+    const char *names[N_STRINGS] = {"contact", "material", "parameter", "unit", "status", "flags"};
+    hid_t strings[N_STRINGS];
+    for (int k = 0; k < N_STRINGS; ++k) {
         strings[k] = H5Tcopy(H5T_C_S1);
         H5Tset_size(strings[k], sizes[k]);
         H5Tinsert(type, names[k], offsets[k], strings[k]);
@@ -148,10 +270,10 @@ static int write_table_h5(const char *dir, const row *rows, int n, char *err, si
     hsize_t dims[1] = {(hsize_t)n};
     hid_t space = H5Screate_simple(1, dims, NULL);
     hid_t set = file >= 0 ? H5Dcreate2(file, "calibrated_parameters", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
-    int bad = set < 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0;
+    int bad = set < 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0 || h5_run_status(file, o);
     if (set >= 0) H5Dclose(set);
     H5Sclose(space);
-    for (int k = 0; k < 4; ++k) H5Tclose(strings[k]);
+    for (int k = 0; k < N_STRINGS; ++k) H5Tclose(strings[k]);
     H5Tclose(type);
     if (file >= 0) bad |= H5Fclose(file) < 0;
     free(data);
@@ -359,6 +481,42 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
     report_identified(f, r, bounds);
 }
 
+// A stage's posterior beside its Δχ² ranges, and which measurement moves with which parameter.
+static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bounds *b, const cal_posterior *p,
+                             const char *why)
+{
+    if (!p) {
+        fprintf(f, "\nNo posterior: %s.\n", why);
+        return;
+    }
+    fprintf(f, "\nPosterior of (μs, log10 μr) given the data (MCMC, %d samples over %d chains, acceptance %.2f; flat "
+               "prior over the search's bounds), on %s; each measurement's spread is the data's, the map's rms "
+               "residual and the kriging's own, in quadrature. The chains' medians lie within %.3f (μs) and %.3f "
+               "(log μr) of the search range of each other.\n\n| | median | 95 %% credible interval | Δχ² identified "
+               "(not excluded) |\n|---|---|---|---|\n",
+            p->n, CAL_POSTERIOR_CHAINS, p->acceptance, p->model, p->chain_spread[0], p->chain_spread[1]);
+    const cal_range *g[2] = {&r->mu_s_range, &r->mu_r_range};
+    const char *names[2] = {"μs", "μr"};
+    for (int k = 0; k < 2; ++k)
+        fprintf(f, "| %s | %.3g | %.3g – %.3g%s | %.3g – %.3g (%.3g – %.3g) |\n", names[k], p->median[k], p->lo[k],
+                p->hi[k], p->reaches_lower[k] && p->reaches_upper[k] ? " (both bounds)"
+                          : p->reaches_lower[k]                      ? " (to the lower bound)"
+                          : p->reaches_upper[k]                      ? " (to the upper bound)"
+                                                                     : "",
+                g[k]->lo, g[k]->hi, g[k]->bracket_lo, g[k]->bracket_hi);
+    fputs("\nWhat each measurement can tell (its change across each parameter's whole search range, the other at "
+          "its posterior median, in the data's spreads; below 1 it cannot tell that parameter at all):\n\n"
+          "| measurement | data spread | across μs | across μr |\n|---|---|---|---|\n", f);
+    for (int k = 0; k < p->n_y; ++k)
+        fprintf(f, "| %s | %.3g | %+.2f | %+.2f |\n", p->observable[k], p->data_sd[k], p->sensitivity[k][0],
+                p->sensitivity[k][1]);
+    double lo[2] = {b->mu_s_min, b->mu_r_min}, hi[2] = {b->mu_s_max, b->mu_r_max};
+    for (int k = 0; k < 2; ++k)
+        if (cal_posterior_blind(p, k))
+            fprintf(f, "\n**The data cannot tell this stage's %s**: no measurement moves by one spread across its "
+                       "whole search range; any value in %.3g – %.3g fits.\n", names[k], lo[k], hi[k]);
+}
+
 static void cost_row(FILE *f, const char *stage, const char *tier, int candidates, int simulations, double core_s)
 {
     fprintf(f, "| %s | %s | %d | %d | %.2f |\n", stage, tier, candidates, simulations, core_s / 3600);
@@ -394,7 +552,8 @@ static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
           "systems spend about 80 (GrainLearning) to 480 (ACCES) simulations per calibration.\n", f);
 }
 
-static int write_report(const char *dir, const cal_outcome *o, const sim_tally *tally, char *err, size_t len)
+static int write_report(const char *dir, const cal_outcome *o, const posteriors *post, const sim_tally *tally,
+                        char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/report.md", dir);
@@ -402,11 +561,18 @@ static int write_report(const char *dir, const cal_outcome *o, const sim_tally *
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     const cal_tier *t = o->tier;
-    fprintf(f, "# granucal calibration\n\nCommand: `%s`  \nConfig: `%s`, tier `%s` (drum λ = %g, %s, up to %g s per "
+    cal_run_status rs = cal_run_status_of(o);
+    fprintf(f, "# granucal %s\n\nCommand: `%s`  \nConfig: `%s`, tier `%s` (drum λ = %g, %s, up to %g s per "
                "speed, window %g s; cylinder λ = %g), granucal %s (commit %s), %d rank(s) × %d worker(s), %.0f s wall.\n\n",
-            o->command, o->config->path, t->name, t->lambda, t->slice_depth > 0 ? "periodic slice" : "full drum",
-            t->max_time, t->window, t->cylinder_lambda, exp_version(), cal_build_commit(), o->ranks, o->workers,
-            o->wall_time_s);
+            rs.demonstration ? "demonstration (not a calibration of this powder)" : "calibration", o->command,
+            o->config->path, t->name, t->lambda, t->slice_depth > 0 ? "periodic slice" : "full drum", t->max_time,
+            t->window, t->cylinder_lambda, exp_version(), cal_build_commit(), o->ranks, o->workers, o->wall_time_s);
+    cal_run_status_banner(f, &rs, "> ");
+    fputs("\nValues the data did not choose (each row's status in `calibrated_parameters.csv`):\n\n", f);
+    long before = ftell(f);
+    cal_table_caveats(f, o, "- ");
+    if (ftell(f) == before) fputs("- none: every friction was chosen by the data.\n", f);
+    fputc('\n', f);
     fputs("Files: `calibrated_parameters.{csv,md,h5}`, `simulations.csv` (every simulation, its cost and status), "
           "plots `cn_vs_k.png`, `angle_map_*.png`, `csa_vs_rpm_*.png`, `convergence_*.png`, and "
           "`liggghts_parameters.in`, `lammps_parameters.in`.\n", f);
@@ -431,8 +597,12 @@ static int write_report(const char *dir, const cal_outcome *o, const sim_tally *
                        "cylinder λ 32768 the CN rose below 50 N/m, results/stiffness_low_k/).\n",
                     s->k[0], o->config->k_n);
     }
-    if (o->granule) report_friction(f, o->granule, &o->config->granule);
-    for (int w = 0; w < o->n_walls; ++w) report_friction(f, o->walls[w], &o->config->wall);
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i)
+        if (stage_of(o, i)) {
+            const cal_bounds *b = i ? &o->config->wall : &o->config->granule;
+            report_friction(f, stage_of(o, i), b);
+            report_posterior(f, stage_of(o, i), b, post->ok[i] ? &post->of[i] : NULL, post->why[i]);
+        }
     report_cost(f, o, tally);
     cal_export_report(f, dir);
     return cal_atomic_commit(&a, err, len);
@@ -440,15 +610,20 @@ static int write_report(const char *dir, const cal_outcome *o, const sim_tally *
 
 int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t len)
 {
-    row rows[64];
-    int n = table_rows(&o->table, rows);
+    cal_table_row rows[CAL_TABLE_MAX_ROWS];
+    int n = cal_table_rows(o, rows);
     char store[1100];
     snprintf(store, sizeof store, "%s/store", dir);
     sim_tally tally = {0};
-    int bad = write_table_csv(dir, rows, n, err, len) || write_table_md(dir, &o->table, err, len) ||
-              write_table_h5(dir, rows, n, err, len) || cal_export_write(dir, o, err, len) || write_simulations(dir, store, o, &tally, err, len) ||
-              write_report(dir, o, &tally, err, len);
+    posteriors *post = malloc(sizeof *post);
+    if (!post) return exp_fail(err, len, "out of memory");
+    posteriors_sample(o, post);
+    int bad = write_table_csv(dir, o, post, rows, n, err, len) || write_table_md(dir, o, post, rows, n, err, len) ||
+              write_table_h5(dir, o, rows, n, err, len) || cal_export_write(dir, o, err, len) ||
+              write_simulations(dir, store, o, &tally, err, len) || write_report(dir, o, post, &tally, err, len);
     free(tally.hash);
+    posteriors_free(post);
+    free(post);
     if (bad) return 1;
     if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
     if (o->granule && cal_figures_friction(dir, &o->config->granule, o->granule, err, len)) return 1;

@@ -13,14 +13,17 @@
 typedef struct cal_table {
     double density, xi, k_n;
     const char *k_source;
+    int k_calibrated;     ///< 1: k_n chosen by stage 1 (this run or an earlier one); 0: the config's
     double gg_mu_s, gg_mu_r;
     cal_range gg_mu_s_range, gg_mu_r_range; ///< identified ranges; NAN where the stage was not run
     const char *gg_source;
+    int gg_angle_matched; ///< the stage's pair matched the angle: 1, 0, or -1 unknown (an earlier run's stage file)
     int n_walls;
     char wall_name[16][32];
     double wall_mu_s[16], wall_mu_r[16];
     cal_range wall_mu_s_range[16], wall_mu_r_range[16];
     char wall_source[16][96];
+    int wall_angle_matched[16]; ///< as gg_angle_matched
 } cal_table;
 
 /// Everything the run found; stages not run are NULL.
@@ -32,6 +35,7 @@ typedef struct cal_outcome {
     const cal_friction_result *walls[16];
     int n_walls;
     cal_table table;
+    int angle_data_synthetic, csa_data_synthetic; ///< the data files say SYNTHETIC (cal_series.synthetic)
     const char *command;
     double wall_time_s;
     int ranks, workers;

@@ -78,10 +78,12 @@ static double squared_z(double value, double target, double sd, int usable)
     return usable && isfinite(z) ? z * z : failed_speed_penalty;
 }
 
+double cal_friction_angle_spread(const cal_friction_result *r) { return fmax(r->angle_tolerance, min_angle_sd); }
+
 // The angle's squared z-score against its tolerance.
 static double angle_z2(const cal_friction_result *r, const cal_candidate *k)
 {
-    return squared_z(k->angle_deg, r->angle_target, fmax(r->angle_tolerance, min_angle_sd), 1);
+    return squared_z(k->angle_deg, r->angle_target, cal_friction_angle_spread(r), 1);
 }
 
 // Speed i's CSA spread: the lab's (floored), and the tier's added in quadrature (tier_sd 0: the lab's alone).
@@ -92,6 +94,17 @@ static double csa_spread(const cal_friction_result *r, int i, double tier_sd)
 }
 
 double cal_friction_csa_spread(const cal_friction_result *r, int i) { return csa_spread(r, i, r->csa_tier_sd[i]); }
+
+int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y)
+{
+    if (!isfinite(k->angle_deg)) return 1;
+    y[0] = k->angle_deg;
+    for (int i = 0; i < r->n_rpm; ++i) {
+        if (!k->usable[i] || !isfinite(k->csa[i])) return 1;
+        y[1 + i] = k->csa[i];
+    }
+    return 0;
+}
 
 // Speed i's CSA squared z-score against csa_spread.
 static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
@@ -417,7 +430,8 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     // granules pile steeper, Table B.1) is not corrected here by a number
     // measured at any known answer; the tier's table is the tier's.
     r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
-    r->angle_source = angles->provenance, r->csa_source = areas->provenance;
+    r->angle_source = (cal_provenance){angles->synthetic, angles->synthetic_lambda};
+    r->csa_source = (cal_provenance){areas->synthetic, areas->synthetic_lambda};
     // The tier's spreads are one bed's; a candidate is the mean of its beds.
     double per_bed = 1 / sqrt(cal_tier_beds(s->t)), tier_angle_sd = s->t->angle_sd_deg * per_bed;
     r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + tier_angle_sd * tier_angle_sd);

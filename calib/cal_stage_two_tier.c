@@ -34,19 +34,6 @@ typedef struct two_tier {
 
 static int n_measurements(const cal_friction_result *r) { return 1 + r->n_rpm; }
 
-// A candidate's measurement vector (angle, then CSA per speed); 1 if a
-// measurement is missing (failed or unsteady: not a point of any map).
-static int vector_of(const cal_friction_result *r, const cal_candidate *k, double *y)
-{
-    if (!isfinite(k->angle_deg)) return 1;
-    y[0] = k->angle_deg;
-    for (int i = 0; i < r->n_rpm; ++i) {
-        if (!k->usable[i] || !isfinite(k->csa[i])) return 1;
-        y[1 + i] = k->csa[i];
-    }
-    return 0;
-}
-
 static void candidate_of(const cal_friction_result *r, const double *y, cal_candidate *k)
 {
     k->angle_deg = y[0];
@@ -71,7 +58,7 @@ static int run_here(double u, double v, double *y, void *ctx)
     cal_friction_to_mu(t->bounds, u, v, &mu_s, &mu_r);
     const cal_candidate *k = cal_friction_evaluate(t->search, mu_s, mu_r, "two-tier");
     if (!k) return 1;
-    if (vector_of(t->r, k, y)) // a failed run: measured as far off as the penalty says, and not agreeing
+    if (cal_candidate_vector(t->r, k, y)) // a failed run: measured as far off as the penalty says, and not agreeing
         for (int i = 0; i < n_measurements(t->r); ++i) y[i] = NAN;
     return 0;
 }
@@ -83,7 +70,7 @@ static int fit_map(const cal_friction_result *cheap, const cal_bounds *b, int n_
     if (!pts) return 1;
     int n = 0;
     for (int i = 0; i < cheap->n; ++i)
-        if (!vector_of(cheap, &cheap->cand[i], pts[n].y)) {
+        if (!cal_candidate_vector(cheap, &cheap->cand[i], pts[n].y)) {
             cal_friction_to_unit(b, cheap->cand[i].mu_s, cheap->cand[i].mu_r, &pts[n].u, &pts[n].v);
             n++;
         }
@@ -98,7 +85,7 @@ static void add_predicted(cal_friction_result *r, const cal_friction_result *che
 {
     for (int i = 0; i < cheap->n && r->n < CAL_MAX_EVALS; ++i) {
         double y[CAL_MF_MAX_Y], u, v;
-        if (vector_of(cheap, &cheap->cand[i], y)) continue;
+        if (cal_candidate_vector(cheap, &cheap->cand[i], y)) continue;
         cal_friction_to_unit(b, cheap->cand[i].mu_s, cheap->cand[i].mu_r, &u, &v);
         cal_mf_correct(correction, n_measurements(r), u, v, y);
         cal_candidate *k = &r->cand[r->n++];
@@ -121,9 +108,10 @@ static const char *outcome_of(const cal_mf_result *m)
 // What the loop did, into the stage's result (and on stderr): its runs
 // against their predictions, the outcome, the correction, and the map's
 // candidates corrected as predicted candidates.
-static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const cal_mf_result *m,
-                      const char *tier, const cal_bounds *b)
+static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const cal_mf_map *map,
+                      const cal_mf_result *m, const char *tier, const cal_bounds *b)
 {
+    out->has_map = !m->failed && m->n > 0, out->cheap_map = *map, out->discrepancy = m->correction;
     out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
     out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
     for (int k = 0; k < n_measurements(out); ++k) out->correction[k] = m->delta[k];
@@ -175,7 +163,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     cal_mf_result *m = calloc(1, sizeof *m);
     if (!m) return cal_friction_finish(tt.search), exp_fail(err, len, "out of memory");
     cal_mf_search(&map, &p, m);
-    keep_loop(out, cheap, m, t->name, tt.bounds);
+    keep_loop(out, cheap, &map, m, t->name, tt.bounds);
     free(m);
     return cal_friction_finish(tt.search);
 }

@@ -9,6 +9,7 @@
 
 #include "cal_config.h"
 #include "cal_data.h"
+#include "cal_multifidelity.h"
 #include "cal_sim.h"
 
 enum { CAL_MAX_K = 64, CAL_MAX_EVALS = 512, CAL_MAX_RPM = 16 };
@@ -110,6 +111,13 @@ typedef struct cal_friction_result {
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
     const char *map_correction;         ///< "kriging" or "affine" (cal_mf_correction_kind)
+    /// The map the two-tier search ended with: the map tier's quadratic map in
+    /// this stage's unit square and the discrepancy measured at this tier's
+    /// runs (the posterior samples it: cal_posterior.h). has_map 0: a one-tier
+    /// stage, or a loop that made no run.
+    int has_map;
+    cal_mf_map cheap_map;
+    cal_mf_correction discrepancy;
 } cal_friction_result;
 
 /// A candidate's scores from its measurements (angle_deg, csa, usable):
@@ -175,6 +183,12 @@ void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double 
 /// Speed i's CSA spread in the χ² and the misfit: the lab's (floored) and the
 /// tier's in quadrature.
 double cal_friction_csa_spread(const cal_friction_result *r, int i);
+/// The angle's spread in the χ² and the misfit: its tolerance, floored.
+double cal_friction_angle_spread(const cal_friction_result *r);
+/// A candidate's measurement vector: its angle, then its CSA at each speed
+/// (the order of cal_mf_point.y); 1 if a measurement is missing (failed or
+/// unsteady: not a point of any map).
+int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y);
 
 /// The same stage across two tiers (the tier's map_tier maps, the tier itself
 /// decides; cal_multifidelity.h): the cheap tier's whole search first (its

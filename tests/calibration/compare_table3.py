@@ -6,6 +6,9 @@
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv > comparison.md
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv --expect COMMITTED.md
 #
+# A row whose status (calibrated_parameters.csv) says the data did not choose its value (one-sided on a
+# search bound, not identified, not a result, stage not run) is not scored as a pass or a fail of its
+# value: its verdict is that status.
 # RUN_DIR holds calibrated_parameters.csv (value, not_excluded_min/max) and calibrated_parameters.md
 # (its Source column says whether stage 1 resolved the stiffness). Prints one row per tolerance
 # entry and a summary; exit status 0 when it could compare (whatever the verdicts), 2 on bad input.
@@ -33,8 +36,28 @@ def stage1_resolved(run_dir):
     return False
 
 
+def judge_status(rule, paper, got):
+    """A row the data did not choose (its status column, calib/cal_status.h) is no value to score:
+    (verdict, what was measured), or None for a row whose value stands."""
+    status = got.get('status') or 'calibrated'
+    if status in ('calibrated', 'input', 'derived') or rule == 'carried':
+        return None
+    if status == 'one-sided':
+        upper = 'at_upper_bound' in got['flags']
+        known = float(got['not_excluded_min'] if upper else got['not_excluded_max'])
+        holds = paper >= known if upper else paper <= known
+        return 'one-sided', 'only %s %.3g known: Table 3 %s it' % ('≥' if upper else '≤', known,
+                                                                  'agrees with' if holds else 'lies outside')
+    if status == 'not a result' and rule == 'inside':
+        return None  # the interval the data leave stands even where the search's point lies outside it
+    return status, got['flags']
+
+
 def judge(rule, tol, paper, got, row, resolved):
     """(verdict, what was measured)"""
+    by_status = judge_status(rule, paper, got)
+    if by_status:
+        return by_status
     value = float(got['value'])
     if rule == 'carried':
         ok = math.isclose(value, paper, rel_tol=1e-4)

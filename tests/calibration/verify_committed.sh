@@ -10,7 +10,9 @@
 #     With MAX_RERUN_S set, the picks are drawn only among the records whose own recorded wall time is
 #     at most that many seconds (a converged drum's slowest runs take 20 minutes; CI has less), and
 #     the script says how many records that left to draw from.
-#   usage: [MAX_RERUN_S=S] [SEED=N] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
+#   With SAYS="TIER PURPOSE DATA" set (e.g. "standard calibration angle lab / CSA synthetic"), the
+#   re-derived outputs must also say what the run is (check_outputs_say_what.py).
+#   usage: [MAX_RERUN_S=S] [SEED=N] [SAYS=...] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
 #   (N = 0: step 1 alone)
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
 # files, and the data files the run read (repose_angle.csv, occupied_area.csv): for a run made with
@@ -56,6 +58,12 @@ else
   fails=$((fails + 1))
 fi
 python3 "$src/tests/calibration/check_value_in_range.py" "$work/out" || fails=$((fails + 1))
+# SAYS="TIER PURPOSE DATA...": every re-derived output must say what the run is (check_outputs_say_what.py).
+if [ -n "${SAYS:-}" ]; then
+  read -r says_tier says_purpose says_data <<< "$SAYS"
+  python3 "$src/tests/calibration/check_outputs_say_what.py" "$work/out" --tier "$says_tier" --purpose "$says_purpose" \
+    --data "$says_data" || fails=$((fails + 1))
+fi
 if [ "$n" -eq 0 ]; then # nothing to rerun: a second derivation would only repeat the first
   echo "$fails failure(s)"
   exit $((fails > 0))

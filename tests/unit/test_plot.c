@@ -307,16 +307,16 @@ static void synthetic_data_known_from_the_header(void **state)
     fclose(f);
     cal_series s;
     if (cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err)) fail_msg("%s", err);
-    assert_int_equal(s.provenance.synthetic, 1);
-    assert_float_equal(s.provenance.lambda, 512, 0);
+    assert_int_equal(s.synthetic, 1);
+    assert_float_equal(s.synthetic_lambda, 512, 0);
     cal_series_free(&s);
     f = fopen(path, "w");
     assert_non_null(f);
     fputs("# lab measurements (lambda 1 would be the real powder)\nsurface,rpm,csa_percent,csa_sd_percent\nPP,4,45.2,0.1\n", f);
     fclose(f);
     if (cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err)) fail_msg("%s", err);
-    assert_int_equal(s.provenance.synthetic, 0);
-    assert_true(isnan(s.provenance.lambda));
+    assert_int_equal(s.synthetic, 0);
+    assert_true(isnan(s.synthetic_lambda));
     cal_series_free(&s);
     remove(path);
 }

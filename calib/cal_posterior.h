@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_posterior.h
+/// What the data say about a friction stage's (μs, μr), beyond the Δχ² cut
+/// over the runs made: the posterior of (μs, log10 μr) given the data and
+/// their spreads, sampled by MCMC on the stage's map of the measurements, and
+/// how far each measurement moves across each parameter's search range.
+///
+/// The model of a measurement at (u, v) of the unit square: the two-tier
+/// stage's corrected map (the map tier's quadratic map plus the discrepancy
+/// measured at this tier's runs), or, for a one-tier stage, a least-squares
+/// map through its own candidates (cal_mf_fit: quadratic with 8 or more,
+/// linear with 3 or more). Its spread: the data's (the angle's tolerance,
+/// the CSA's lab and tier spreads), the map's rms residual and the kriging's
+/// own standard deviation there (cal_mf_correction_sd), in quadrature. Prior:
+/// flat over the search's bounds in μs and log10 μr.
+#ifndef CAL_POSTERIOR_H
+#define CAL_POSTERIOR_H
+
+#include "cal_stages.h"
+
+enum { CAL_POSTERIOR_CHAINS = 4 };
+
+typedef struct cal_posterior {
+    const char *model;                  ///< which map the posterior samples (see above)
+    int n_y;                            ///< measurements: the angle, then the CSA at each speed
+    char observable[CAL_MF_MAX_Y][32];  ///< "angle at 4 rpm", "CSA at 116 rpm"
+    double data_sd[CAL_MF_MAX_Y];       ///< the data's spread of each
+    int n;                              ///< samples kept, over every chain
+    double *mu_s, *mu_r;                ///< the samples
+    double acceptance;                  ///< of the Metropolis steps after burn-in
+    /// Median and 95 % credible interval (2.5 and 97.5 percentiles) of μs [0]
+    /// and μr [1]; reaches_lower / reaches_upper: the interval runs to within
+    /// 3 % of the search range of that bound, so the data do not hold the
+    /// parameter off it (a flat posterior, whose 2.5 % point sits at 2.5 % of
+    /// the range, reaches both).
+    double median[2], lo[2], hi[2];
+    int reaches_lower[2], reaches_upper[2];
+    /// The chains' medians, furthest apart, in units of the search range: a
+    /// posterior the chains did not explore alike says so.
+    double chain_spread[2];
+    /// How far measurement i moves when μs [0] or log10 μr [1] crosses its
+    /// whole search range (the other at its median), in the data's spreads:
+    /// |value| < 1 means that measurement cannot tell that parameter at all.
+    double sensitivity[CAL_MF_MAX_Y][2];
+} cal_posterior;
+
+/// Sample the posterior of stage r (bounds b). 0 on success; 1 with a
+/// message (and out->n = 0) when there is no map to sample (fewer than three
+/// usable candidates). Deterministic: a fixed seed.
+int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_posterior *out, char *err, size_t len);
+
+/// 1 if no measurement moves by one data spread across parameter p's search range (0: μs, 1: μr).
+int cal_posterior_blind(const cal_posterior *p, int parameter);
+
+void cal_posterior_free(cal_posterior *p);
+
+#endif

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_status.h
+/// What a calibration's outputs are, and what each value in them is: the
+/// one home of the rules that every output (report, table in CSV, Markdown
+/// and HDF5, exports) states.
+///  - The run: calibration or demonstration (the tier's `purpose`), the tier,
+///    the λ the drum and the cylinder ran at, and whether the data are the
+///    lab's or synthetic (a SYNTHETIC comment in the data file).
+///  - Each value: calibrated only when the data chose it: a search bound is
+///    a bound (one-sided), a value outside the interval its own data leave
+///    is not a result, and a parameter the data do not constrain is not
+///    identified.
+#ifndef CAL_STATUS_H
+#define CAL_STATUS_H
+
+#include <stdio.h>
+
+#include "cal_report.h"
+
+/// What one value of the table is.
+typedef enum cal_value_status {
+    CAL_VALUE_INPUT,          ///< given by the config (density, ξ)
+    CAL_VALUE_DERIVED,        ///< set by a rule from another value (k_s = k_r = k_n; boundary = 2 k_n)
+    CAL_VALUE_CALIBRATED,     ///< chosen by the data: inside its own interval, off the search's bounds
+    CAL_VALUE_ONE_SIDED,      ///< on a search bound the data do not close: only "≥ bound" or "≤ bound" is known
+    CAL_VALUE_NOT_IDENTIFIED, ///< the data exclude no value of the search range
+    CAL_VALUE_NOT_A_RESULT,   ///< the search's choice lies outside the interval its own data leave
+    CAL_VALUE_NOT_RUN,        ///< its stage did not run: the config's value, or an unresolved stiffness sweep's
+} cal_value_status;
+
+/// A value's status with the facts behind it.
+typedef struct cal_verdict {
+    cal_value_status status;
+    int side;         ///< one-sided: +1 on the search's upper bound, -1 on its lower bound; else 0
+    double known;     ///< one-sided: what the data do say, "≥ known" (side +1) or "≤ known" (side -1): the
+                      ///< other end of the interval no candidate excludes (the value itself if none)
+    char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, outside_identified,
+                      ///< outside_not_excluded, not_identified, angle_not_matched, stage_not_run,
+                      ///< stiffness_at_cylinder_lambda
+} cal_verdict;
+
+/// A friction's verdict from its identified range g (cal_range; NAN lo: the
+/// stage did not run), the search's bounds, and whether its stage's chosen
+/// pair matched the angle (1, 0, or -1 unknown: the stage was read from an
+/// earlier run's stage file).
+cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched);
+
+/// The status's name as the CSV writes it: "calibrated", "one-sided", ...
+const char *cal_value_status_name(cal_value_status s);
+
+/// The value as a person should read it: "0.192", "≥ 0.775", "not
+/// identified", "not a result". `out` holds at least 48 bytes.
+const char *cal_verdict_value_text(char *out, size_t len, double value, const cal_verdict *v);
+
+/// One row of the table (Table 3's layout) with its verdict.
+typedef struct cal_table_row {
+    const char *contact;   ///< "granule-granule" or "granule-boundary"
+    char material[32];     ///< "" except for a wall's frictions
+    const char *parameter; ///< density, k_n, k_s, k_r, xi, mu_s, mu_r
+    double value;
+    const char *unit;
+    cal_range range;       ///< a calibrated friction's identified range; NAN otherwise
+    cal_verdict verdict;
+} cal_table_row;
+
+enum { CAL_TABLE_MAX_ROWS = 64 };
+
+/// The table's rows, each judged; how many (at most CAL_TABLE_MAX_ROWS).
+int cal_table_rows(const cal_outcome *o, cal_table_row *rows);
+
+/// What the run is, for every output.
+typedef struct cal_run_status {
+    int demonstration;                 ///< the tier's purpose is "demonstration"
+    const char *tier;
+    double drum_lambda, cylinder_lambda;
+    int angle_synthetic, csa_synthetic; ///< the data files say SYNTHETIC
+} cal_run_status;
+
+cal_run_status cal_run_status_of(const cal_outcome *o);
+
+/// "calibration" or "demonstration".
+const char *cal_run_purpose(const cal_run_status *s);
+
+/// The data's provenance in one field without commas or semicolons: "angle lab / CSA synthetic".
+const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s);
+
+/// The banner every output opens with, each line led by `prefix` ("# ",
+/// "> ", ""): what the run is, its λ, its data, and how to read each value's
+/// status.
+void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix);
+
+/// One line a value for every friction of the table the data did not choose
+/// (one-sided, not identified, not a result, stage not run), led by
+/// `prefix`; nothing when every friction is calibrated. For files a user
+/// copies values from (the exports), where the table's columns are absent.
+void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix);
+
+#endif

@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+# Every output of a calibration says what it is (calib/cal_status.h):
+#   check_outputs_say_what.py RUN_DIR --tier T --purpose calibration|demonstration --data "angle lab / CSA synthetic"
+# - calibrated_parameters.csv: every row carries tier, lambda, data and purpose as given, and a status;
+#   every friction row's status follows from its own numbers (value, identified range, not-excluded
+#   interval, the search bounds read from the run's config.yaml): a value on a bound is never
+#   'calibrated', a value outside its own interval is 'not a result';
+# - calibrated_parameters.md, report.md, liggghts_parameters.in, lammps_parameters.in: the banner
+#   (DEMONSTRATION or CALIBRATION, the tier, the data's provenance); the two .in files list every
+#   friction the data did not choose (and the stiffness where stage 1 did not choose it) on a
+#   'NOT CALIBRATED:' line, and no other.
+# Exit 1 on any failure, naming it.
+import csv, sys
+
+import yaml  # python3-yaml (.ci/setup)
+
+FRICTION_STATUSES = {'calibrated', 'one-sided', 'not identified', 'not a result', 'stage not run'}
+
+
+def bounds(run_dir):
+    """The search bounds the run used: its config.yaml's granule: and wall: mappings."""
+    with open(run_dir + '/config.yaml') as f:
+        config = yaml.safe_load(f)
+    return {(block, k): float(v) for block in ('granule', 'wall') for k, v in config[block].items()}
+
+
+def expected_status(r, lo_bound, hi_bound):
+    if r['identified_min'] == '':
+        return 'stage not run'
+    v = float(r['value'])
+    lo, hi = float(r['identified_min']), float(r['identified_max'])
+    blo, bhi = float(r['not_excluded_min']), float(r['not_excluded_max'])
+    slack = 1e-6
+    outside = lambda a, b: v < a * (1 - slack) or v > b * (1 + slack)
+    near = lambda a, b: abs(a - b) <= 1e-9 * abs(b)
+    if outside(lo, hi) or outside(blo, bhi):
+        return 'not a result'
+    if near(blo, lo_bound) and near(bhi, hi_bound):
+        return 'not identified'
+    if near(v, lo_bound) or near(v, hi_bound):
+        return 'one-sided'
+    return 'calibrated'
+
+
+def check_csv(run_dir, want, fails):
+    b = bounds(run_dir)
+    with open(run_dir + '/calibrated_parameters.csv') as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        fails.append('calibrated_parameters.csv: no rows')
+    not_chosen = []
+    for r in rows:
+        name = ' '.join(x for x in (r['contact'], r['material'], r['parameter']) if x)
+        for field in ('tier', 'data', 'purpose'):
+            if r.get(field) != want[field]:
+                fails.append('csv %s: %s is %r, expected %r' % (name, field, r.get(field), want[field]))
+        if not r.get('status'):
+            fails.append('csv %s: no status' % name)
+        if r['parameter'] not in ('mu_s', 'mu_r'):
+            if r['status'] == 'stage not run' and r['parameter'] == 'k_n' and r['contact'] == 'granule-granule':
+                not_chosen.append((r, name))  # the config's stiffness: the exports must say so too
+            continue
+        block = 'granule' if r['contact'] == 'granule-granule' else 'wall'
+        p = r['parameter']
+        expected = expected_status(r, b[(block, p + '_min')], b[(block, p + '_max')])
+        if r['status'] != expected:
+            fails.append('csv %s: status %r, its numbers say %r' % (name, r['status'], expected))
+        if r['status'] != 'calibrated':
+            not_chosen.append((r, name))
+    return not_chosen
+
+
+def check_banner(path, want, fails):
+    with open(path) as f:
+        text = f.read()
+    head = 'DEMONSTRATION - not a calibration of this powder' if want['purpose'] == 'demonstration' else 'CALIBRATION at'
+    for needle in (head, "tier '%s'" % want['tier']):
+        if needle not in text:
+            fails.append('%s: no %r' % (path, needle))
+    angle_synthetic, csa_synthetic = ('angle synthetic' in want['data']), ('CSA synthetic' in want['data'])
+    data_line = [l for l in text.splitlines() if 'Data: repose angle' in l]
+    if len(data_line) != 1:
+        fails.append('%s: %d data provenance lines' % (path, len(data_line)))
+    else:
+        said = data_line[0].split('occupied area')
+        if ('SYNTHETIC' in said[0]) != angle_synthetic or ('SYNTHETIC' in said[1]) != csa_synthetic:
+            fails.append('%s: the data line says %r for data %r' % (path, data_line[0], want['data']))
+    return text
+
+
+def check_exports(run_dir, want, not_chosen, fails):
+    for name in ('liggghts_parameters.in', 'lammps_parameters.in'):
+        path = run_dir + '/' + name
+        text = check_banner(path, want, fails)
+        lines = [l for l in text.splitlines() if l.startswith('# NOT CALIBRATED: ')]
+        for r, row_name in not_chosen:
+            hits = [l for l in lines if l.startswith('# NOT CALIBRATED: %s = ' % row_name) and r['status'] in l]
+            if len(hits) != 1:
+                fails.append('%s: %d NOT CALIBRATED lines for %s (%s)' % (name, len(hits), row_name, r['status']))
+        if len(lines) != len(not_chosen):
+            fails.append('%s: %d NOT CALIBRATED lines for %d values' % (name, len(lines), len(not_chosen)))
+
+
+def main():
+    args = sys.argv[1:]
+    if len(args) != 7 or args[1::2] != ['--tier', '--purpose', '--data']:
+        print(__doc__ or 'usage: check_outputs_say_what.py RUN_DIR --tier T --purpose P --data D', file=sys.stderr)
+        return 2
+    run_dir = args[0]
+    want = {'tier': args[2], 'purpose': args[4], 'data': args[6]}
+    fails = []
+    not_chosen = check_csv(run_dir, want, fails)
+    for name in ('calibrated_parameters.md', 'report.md'):
+        check_banner(run_dir + '/' + name, want, fails)
+    check_exports(run_dir, want, not_chosen, fails)
+    for f in fails:
+        print('FAIL: ' + f)
+    if fails:
+        print('%d failure(s)' % len(fails))
+    else:
+        print('ok   every output says what it is (%s, tier %s, %s); %d value(s) the data did not choose, '
+              'each marked' % (want['purpose'], want['tier'], want['data'], len(not_chosen)))
+    return 1 if fails else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// The posterior of a friction stage (calib/cal_posterior.c) on maps whose
+// posterior is known in closed form: an angle linear in u with a Gaussian
+// spread (the posterior of u a Gaussian, of v flat: uniform in log10 μr), and
+// the kriging's variance growing away from its runs.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "cal_posterior.h"
+
+static const cal_bounds bounds = {0.1, 1.0, 1e-5, 0.5};
+
+// A stage measuring the angle alone, whose map is angle = 30 + 10 u (u: μs
+// over its bounds), target 35 ± 0.5: u* = 0.5 (μs 0.55), σ_u = 0.05.
+static cal_friction_result *linear_stage(void)
+{
+    cal_friction_result *r = calloc(1, sizeof *r);
+    r->angle_target = 35, r->angle_tolerance = 0.5, r->angle_rpm = 4;
+    r->best = -1, r->has_map = 1;
+    r->cheap_map.n_y = 1, r->cheap_map.n_terms = 3;
+    r->cheap_map.coef[0][0] = 30, r->cheap_map.coef[0][1] = 10; // 1, u, v
+    return r;
+}
+
+static void test_a_linear_angle_gives_a_gaussian_in_mu_s_and_a_flat_mu_r(void **state)
+{
+    (void)state;
+    cal_friction_result *r = linear_stage();
+    cal_posterior p;
+    char err[200];
+    assert_int_equal(cal_posterior_sample(r, &bounds, &p, err, sizeof err), 0);
+    // μs = 0.1 + 0.9 u: median 0.55, 95 % interval 0.55 ± 1.96 × 0.9 × 0.05 = 0.55 ± 0.0882.
+    // Monte Carlo error of a quantile with ~12 000 correlated samples: allow 0.01.
+    assert_float_equal(p.median[0], 0.55, 0.01);
+    assert_float_equal(p.lo[0], 0.55 - 0.0882, 0.01);
+    assert_float_equal(p.hi[0], 0.55 + 0.0882, 0.01);
+    assert_false(p.reaches_lower[0] || p.reaches_upper[0]);
+    // log10 μr uniform over [-5, log10 0.5]: median at its middle, the interval its 2.5 and 97.5 %.
+    double a = -5, b = log10(0.5);
+    assert_float_equal(log10(p.median[1]), a + 0.5 * (b - a), 0.03 * (b - a));
+    assert_float_equal(log10(p.lo[1]), a + 0.025 * (b - a), 0.015 * (b - a));
+    assert_float_equal(log10(p.hi[1]), a + 0.975 * (b - a), 0.015 * (b - a));
+    assert_true(p.reaches_lower[1] && p.reaches_upper[1]); // a flat posterior runs to both bounds
+    // The angle moves 10° = 20 spreads across μs, nothing across μr: μr is blind.
+    assert_float_equal(p.sensitivity[0][0], 20, 1e-9);
+    assert_float_equal(p.sensitivity[0][1], 0, 1e-9);
+    assert_false(cal_posterior_blind(&p, 0));
+    assert_true(cal_posterior_blind(&p, 1));
+    assert_true(p.acceptance > 0.1 && p.acceptance < 0.7);
+    assert_true(p.chain_spread[0] < 0.02);
+    cal_posterior_free(&p);
+    free(r);
+}
+
+static void test_a_target_beyond_the_map_piles_on_the_bound(void **state)
+{
+    (void)state;
+    cal_friction_result *r = linear_stage();
+    r->angle_target = 45; // the map reaches 40 at most (u = 1): the posterior presses on μs's upper bound
+    cal_posterior p;
+    char err[200];
+    assert_int_equal(cal_posterior_sample(r, &bounds, &p, err, sizeof err), 0);
+    assert_true(p.reaches_upper[0] && !p.reaches_lower[0]);
+    assert_true(p.median[0] > 0.95);
+    cal_posterior_free(&p);
+    free(r);
+}
+
+static void test_kriging_sd_is_the_nugget_at_a_run_and_the_scale_far_away(void **state)
+{
+    (void)state;
+    // Two runs 0.5 apart (kernel length 0.25), scale 2, nugget 1e-9: at a run the variance is
+    // scale² (1 - kᵀK⁻¹k) = 0 up to the nugget; far from both, scale.
+    cal_mf_correction c = {0};
+    c.n_runs = 2, c.run_u[0] = 0.25, c.run_v[0] = 0.5, c.run_u[1] = 0.75, c.run_v[1] = 0.5;
+    c.scale[0] = 2, c.nugget[0] = 1e-9;
+    assert_float_equal(cal_mf_correction_sd(&c, 0, 0.25, 0.5), 0, 1e-3);
+    assert_float_equal(cal_mf_correction_sd(&c, 0, 0.5, 5.0), 2, 1e-9);
+    // Between the runs: k = exp(-0.25²/(2·0.25²)) = e^-0.5 each; K = [[1, e^-2], [e^-2, 1]]:
+    // 1 - 2 e^-1 / (1 + e^-2) = 0.35240, times scale².
+    assert_float_equal(cal_mf_correction_sd(&c, 0, 0.5, 0.5), 2 * sqrt(1 - 2 * exp(-1) / (1 + exp(-2))), 1e-6);
+    // No kriging: no variance model.
+    c.scale[0] = 0;
+    assert_float_equal(cal_mf_correction_sd(&c, 0, 0.5, 0.5), 0, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_a_linear_angle_gives_a_gaussian_in_mu_s_and_a_flat_mu_r),
+        cmocka_unit_test(test_a_target_beyond_the_map_piles_on_the_bound),
+        cmocka_unit_test(test_kriging_sd_is_the_nugget_at_a_run_and_the_scale_far_away),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
