@@ -201,14 +201,19 @@ static double widest_text(size_t n, const char *const *text, double char_mm)
     return 0.72 * char_mm * (double)widest;
 }
 
+// Characters of the widest y tick label granucal wrote itself in the last
+// frame (a narrow log axis: label_narrow_log_axis), 0 where PLplot wrote them.
+static int own_y_label_chars;
+
 // Where the y label goes (in character heights from the axis): clear of the
-// widest tick label PLplot wrote in the last plbox (plgyax: its characters;
+// widest tick label of the last frame (PLplot's: plgyax gives its characters;
 // a digit is about 0.85 of the character height wide at this font).
 static double ylabel_offset(void)
 {
     PLINT digmax = 0, digits = 0;
     plgyax(&digmax, &digits);
-    return fmin(7.0, fmax(5.0, 0.7 + 0.85 * digits + 0.9));
+    int chars = digits > own_y_label_chars ? digits : own_y_label_chars;
+    return fmin(7.0, fmax(5.0, 0.7 + 0.85 * chars + 0.9));
 }
 
 static void title_and_labels(const char *title, const char *xlabel, const char *ylabel)
@@ -244,6 +249,7 @@ static void label_narrow_log_axis(int y_axis, double lo, double hi)
             double at = log10(m) + e;
             if (at < lo - 1e-9 || at > hi + 1e-9) continue;
             snprintf(text, sizeof text, "%g", m * pow(10, e));
+            if (y_axis && (int)strlen(text) > own_y_label_chars) own_y_label_chars = (int)strlen(text);
             if (y_axis) plmtex("lv", 0.7, (at - lo) / (hi - lo), 1.0, text);
             else plmtex("b", 1.6, (at - lo) / (hi - lo), 0.5, text);
         }
@@ -262,6 +268,7 @@ static void frame(int log_x, int log_y, double x0, double x1, double y0, double 
     snprintf(xopt, sizeof xopt, "bcst%s%s%s", narrow_x ? "" : "n", log_x ? "l" : "", fixed_x ? "f" : "");
     snprintf(yopt, sizeof yopt, "bcstv%s%s%s", narrow_y ? "" : "n", log_y ? "l" : "", fixed_y ? "f" : "");
     plbox(xopt, 0, 0, yopt, 0, 0);
+    own_y_label_chars = 0;
     if (narrow_x) label_narrow_log_axis(0, x0, x1);
     if (narrow_y) label_narrow_log_axis(1, y0, y1);
 }
