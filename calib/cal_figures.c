@@ -149,6 +149,9 @@ static void convergence_collect(const cal_friction_result *r, convergence_data *
         d->step_best[2 * j] = d->step_best[2 * j + 1] = isfinite(running) ? running : NAN;
         if (i == r->best) d->chosen_index[0] = j + 1, d->chosen_objective[0] = k->objective;
     }
+    // The last step holds half a run past the last run: seen even when the
+    // first candidate matching the angle is the last run.
+    if (d->runs > 0) d->step_x[2 * d->runs - 1] = d->runs + 0.5;
 }
 
 static int convergence(const char *dir, const cal_friction_result *r, char *err, size_t len)
@@ -167,7 +170,7 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
     exp_plot_series s[5];
     s[ns++] = points(n, d->index, d->matching, "run matching the angle", blue, EXP_MARK_CIRCLE);
     s[ns++] = points(n, d->index, d->outside, "run outside the angle's tolerance", grey, EXP_MARK_OPEN_CIRCLE);
-    s[ns++] = (exp_plot_series){.n = 2 * n - (n > 0), .x = d->step_x, .y = d->step_best,
+    s[ns++] = (exp_plot_series){.n = 2 * n, .x = d->step_x, .y = d->step_best,
                                 .rgb = {black[0], black[1], black[2]},
                                 .label = r->angle_in_misfit ? "best so far" : "best matching the angle so far"};
     if (isfinite(d->chosen_index[0]))
