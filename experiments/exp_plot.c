@@ -292,13 +292,14 @@ static const char *glyph(exp_plot_marker m)
     return "●";
 }
 
-// An open circle's or diamond's filled twin, drawn white under it so that it
-// reads on a map's colours (NULL for the others; the open square is hollow:
-// what lies under it shows through).
+// An open marker's filled twin, drawn white under it on a map so that it
+// reads on the map's colours (NULL for the others). On a chart open markers
+// are hollow: what lies under them shows through.
 static const char *white_inside(exp_plot_marker m)
 {
     switch (m) {
     case EXP_MARK_OPEN_CIRCLE: return glyph(EXP_MARK_CIRCLE);
+    case EXP_MARK_OPEN_SQUARE: return glyph(EXP_MARK_SQUARE);
     case EXP_MARK_OPEN_DIAMOND: return glyph(EXP_MARK_DIAMOND);
     default: return NULL;
     }
@@ -317,6 +318,15 @@ static double marker_half_mm(exp_plot_marker m, double char_mm)
 }
 
 static void mark(double x, double y, exp_plot_marker m, int colour)
+{
+    text_size(marker_scale(m));
+    plcol0(colour);
+    plstring(1, &x, &y, glyph(m));
+    text_size(TEXT);
+}
+
+// A map's marker: an open one white inside.
+static void map_mark(double x, double y, exp_plot_marker m, int colour)
 {
     text_size(marker_scale(m));
     const char *under = white_inside(m);
@@ -960,13 +970,13 @@ static void map_markers(const exp_plot_map *m, int chosen_colour, int predicted_
         for (size_t i = 0; i < m->n; ++i) {
             double x = m->x[i], y = world(m->y[i], m->log_y);
             if (!isfinite(x) || !isfinite(y) || is_predicted(m, i) != !pass) continue;
-            if (!isfinite(m->z[i])) mark(x, y, EXP_MARK_CROSS, INK);
-            else if (is_predicted(m, i)) mark(x, y, EXP_MARK_OPEN_DIAMOND, predicted_colour);
-            else mark(x, y, EXP_MARK_OPEN_CIRCLE, INK);
+            if (!isfinite(m->z[i])) map_mark(x, y, EXP_MARK_CROSS, INK);
+            else if (is_predicted(m, i)) map_mark(x, y, EXP_MARK_OPEN_DIAMOND, predicted_colour);
+            else map_mark(x, y, EXP_MARK_OPEN_CIRCLE, INK);
         }
     if (m->chosen >= 0 && (size_t)m->chosen < m->n) {
         double x = m->x[m->chosen], y = world(m->y[m->chosen], m->log_y);
-        if (isfinite(x) && isfinite(y)) mark(x, y, EXP_MARK_STAR, chosen_colour);
+        if (isfinite(x) && isfinite(y)) map_mark(x, y, EXP_MARK_STAR, chosen_colour);
     }
 }
 

@@ -32,8 +32,8 @@ typedef enum exp_plot_marker {
     EXP_MARK_STAR, ///< reserved by convention for what was chosen
     EXP_MARK_CROSS,
     EXP_MARK_OPEN_CIRCLE,
-    EXP_MARK_OPEN_SQUARE,  ///< hollow: what it is drawn over, and its own short error bar, show through
-    EXP_MARK_OPEN_DIAMOND, ///< white inside, as the open circle
+    EXP_MARK_OPEN_SQUARE,  ///< open markers are hollow on a chart (what lies under them, and a
+    EXP_MARK_OPEN_DIAMOND, ///< bar shorter than the marker, show through) and white inside on a map
 } exp_plot_marker;
 
 /// One series: n points (x[k], y[k]); a non-finite value breaks the line and
