@@ -104,8 +104,8 @@ static int parse_options(int argc, char **argv, options *o)
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     o->jobs = ncpu > 0 ? (int)ncpu : 1;
     int c;
-    optind = 1;
-    while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+    optind = 1, opterr = 0;
+    while ((c = getopt_long(argc, argv, ":h", longs, NULL)) != -1) {
         double v;
         switch (c) {
         case 't': o->tier = optarg; break;
@@ -127,7 +127,7 @@ static int parse_options(int argc, char **argv, options *o)
             if (cal_parse_checkpoint_every("calibrate", optarg, &o->checkpoint_every_s)) return 2;
             break;
         case 'h': fputs(help, stdout); return -1;
-        default: fputs("\n", stderr), fputs(help, stderr); return 2;
+        default: return cal_option_error("calibrate", c, argv);
         }
     }
     if (optind < argc) o->config = argv[optind++];

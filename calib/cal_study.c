@@ -108,8 +108,8 @@ static int parse_options(int argc, char **argv, options *o)
                                           {"report", required_argument, 0, 'p'}, {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
-    optind = 1;
-    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+    optind = 1, opterr = 0;
+    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
         double v = NAN;
         switch (ch) {
         case 'o': o->out = optarg; break;
@@ -134,7 +134,7 @@ static int parse_options(int argc, char **argv, options *o)
             if (cal_parse_checkpoint_every("study", optarg, &o->checkpoint_every_s)) return 2;
             break;
         case 'h': fputs(help, stdout); return -1;
-        default: fputs(help, stderr); return 2;
+        default: return cal_option_error("study fidelity", ch, argv);
         }
     }
     if (optind < argc) o->config = argv[optind++];
@@ -149,6 +149,24 @@ static int wanted(const char *list, const char *name)
     size_t n = strlen(name);
     for (const char *p = list; (p = strstr(p, name)); p += n)
         if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == 0)) return 1;
+    return 0;
+}
+
+/// Every name of --rungs must be a rung of the ladder: a misspelt one would
+/// otherwise be skipped without a word. The error lists the rungs there are.
+static int check_rungs(const cal_fidelity *f, const char *list, const char *path, char *err, size_t len)
+{
+    char copy[1024];
+    snprintf(copy, sizeof copy, "%s", list);
+    for (char *save = NULL, *t = strtok_r(copy, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        unsigned k = 0;
+        while (k < f->rungs_count && strcmp(f->rungs[k].name, t) != 0) ++k;
+        if (k < f->rungs_count) continue;
+        char names[4096] = "";
+        for (unsigned j = 0; j < f->rungs_count; ++j)
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", j ? ", " : "", f->rungs[j].name);
+        return exp_fail(err, len, "--rungs %s: '%s' is not a rung of %s (fidelity.rungs); its rungs: %s", list, t, path, names);
+    }
     return 0;
 }
 
@@ -658,7 +676,7 @@ int cal_cmd_study(int argc, char **argv)
 {
     if (argc < 2 || strcmp(argv[1], "fidelity") != 0) {
         if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) return fputs(help, stdout), 0;
-        fprintf(stderr, "granucal study: the study to run is `fidelity`\n\n%s", help);
+        fprintf(stderr, "granucal study: the study to run is `fidelity`; see `granucal study --help`\n");
         return 2;
     }
     study *s = calloc(1, sizeof *s);
@@ -676,6 +694,7 @@ int cal_cmd_study(int argc, char **argv)
     if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
     else if (!s->c) status = 1;
     if (!status && s->opt.seeds) s->c->fidelity->seeds = s->opt.seeds;
+    if (!status && s->opt.rungs) status = check_rungs(s->c->fidelity, s->opt.rungs, s->c->path, s->err, sizeof s->err);
     if (!status && s->opt.rpm) status = narrow_speeds(s->c->fidelity, s->opt.rpm, s->c->path, s->err, sizeof s->err);
     if (!status) {
         snprintf(s->out, sizeof s->out, "%s", s->opt.out);

@@ -113,8 +113,8 @@ static int parse_options(int argc, char **argv, options *o)
                                           {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .k_n = NAN, .n_seeds = 3, .seeds = {101, 102, 103},
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
-    optind = 1;
-    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+    optind = 1, opterr = 0;
+    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
         double v;
         switch (ch) {
         case 't': o->tier = optarg; break;
@@ -146,7 +146,7 @@ static int parse_options(int argc, char **argv, options *o)
             o->jobs = (int)v;
             break;
         case 'h': fputs(help, stdout); return -1;
-        default: fputs(help, stderr); return 2;
+        default: return cal_option_error("synthesize", ch, argv);
         }
     }
     if (optind < argc) o->config = argv[optind++];
