@@ -103,8 +103,8 @@ for c in calibrate simulate measure "study fidelity" synthesize; do
   done
 done
 # A wall lining the drum config does not have: the error lists those it has.
-walls=$(sed -n 's/^  - {name: \([^,]*\),.*/\1/p' "$src/configs/drum.yaml" | paste -sd, | sed 's/,/, /g')
-cmd=simulate expect "unknown wall material" "wall = 'Steel': not 'granules' nor a name under materials; the walls are: granules, $walls" -- "$src/configs/drum.yaml" --set wall=Steel --out "$work/out"
+drum_walls=$(sed -n 's/^  - {name: \([^,]*\),.*/\1/p' "$src/configs/drum.yaml" | paste -sd, | sed 's/,/, /g')
+cmd=simulate expect "unknown wall material" "wall = 'Steel': not 'granules' nor a name under materials; the walls are: granules, $drum_walls" -- "$src/configs/drum.yaml" --set wall=Steel --out "$work/out"
 # measure prints JSON: a number it does not have (the spread of one measured photo) is null, not nan.
 json=$(cd "$src" && timeout 60 "$bin" measure results/measure/photo.png "$work/no_such_photo.png" 2>/dev/null)
 if python3 -c 'import json, sys
@@ -113,6 +113,19 @@ rows = [json.loads(l, parse_constant=bad) for l in sys.stdin.read().splitlines()
 assert rows[-1]["measured"] == 1 and rows[-1]["angle_sd_deg"] is None and rows[-1]["csa_sd_percent"] is None, rows[-1]' <<< "$json"; then
   echo "ok   measure: strict JSON, null for the spread of one photo: $(tail -1 <<< "$json")"
 else echo "FAIL measure: not strict JSON with null spreads: $json"; fails=$((fails + 1)); fi
+# synthesize --plan and study --plan: the plan (expected and worst case), exit 0, nothing run or made.
+for c in "synthesize $work/configs/good.yaml --tier ci ${walls[*]}" "study fidelity $work/configs/good.yaml --rungs L4096-slice15"; do
+  msg=$(timeout 20 "$bin" $c --jobs 2 --plan "${out[@]}" 2>&1 >/dev/null); code=$?
+  if [ $code -eq 0 ] && grep -q "^== plan: .*expected [0-9.e+]* core-hours, .* h on 2 worker(s); worst case [0-9.e+]* core-hours" <<< "$msg" &&
+     grep -q -- "--plan: .*nothing was run" <<< "$msg"; then echo "ok   ${c%% *} --plan: $(grep '^== plan: ' <<< "$msg" | tail -1)"
+  else echo "FAIL ${c%% *} --plan: exit $code: $msg"; fails=$((fails + 1)); fi
+done
+# study without --rungs: the whole ladder's plan, then a line asking for --yes, exit 2, nothing run.
+msg=$(timeout 20 "$bin" study fidelity "$work/configs/good.yaml" --jobs 2 "${out[@]}" 2>&1 >/dev/null); code=$?
+if [ $code -eq 2 ] && grep -q "^== plan: study fidelity" <<< "$msg" && grep -q "^   L8-full " <<< "$msg" &&
+   [ "$(tail -1 <<< "$msg")" = "granucal study: no --rungs: the plan above is the whole ladder; run it with --yes, or choose rungs with --rungs A,B (nothing was run)" ]; then
+  echo "ok   study without --rungs: $(tail -1 <<< "$msg")"
+else echo "FAIL study without --rungs: exit $code: $msg"; fails=$((fails + 1)); fi
 [ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }
 echo "$fails failure(s)"
 exit $((fails > 0))
