@@ -452,7 +452,7 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 // is new, and k_n is the stiffest stage 1 may choose. Both are the cost of the
 // whole calibration: records already in OUT/store are not subtracted.
 
-enum { PLAN_MAX_TIERS = 16 };
+enum { PLAN_MAX_TIERS = 16, PLAN_MAX_STEPS = 2 * 16 + 3 }; // stage 1, granule and 16 walls, each with its map
 
 typedef struct plan_pass {
     int worst;
@@ -463,8 +463,8 @@ typedef struct plan_pass {
 } plan_pass;
 
 typedef struct plan {
-    char name[CAL_PROGRESS_MAX_STAGES][64];
-    cal_plan step[CAL_PROGRESS_MAX_STAGES];
+    char name[PLAN_MAX_STEPS][64], what[PLAN_MAX_STEPS][64];
+    cal_plan step[PLAN_MAX_STEPS];
     int n;
     cal_plan total;
     double k_expected, k_worst;
@@ -590,47 +590,60 @@ static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
     to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
 }
 
-// Every step of the progress plan, its expected and worst cost.
+// A step of the plan: its name and what it runs, expected and worst (w = 0, 1).
+static cal_plan *plan_step(plan *p, const char *name, const char *what)
+{
+    if (p->n == PLAN_MAX_STEPS) return &p->step[p->n - 1]; // more materials than the config allows: never
+    snprintf(p->name[p->n], sizeof p->name[0], "%s", name);
+    snprintf(p->what[p->n], sizeof p->what[0], "%s", what);
+    return &p->step[p->n++];
+}
+
+// A friction stage's steps: with a map tier, the map's whole search ("NAME
+// (map)") then this tier's runs; else this tier's search.
+static int plan_friction_steps(run *r, plan *p, plan_pass pass[2], const cal_material *m, const char *name)
+{
+    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
+    char label[64], what[64];
+    for (int step = map ? 0 : 1; step < 2; ++step) {
+        const cal_tier *t = step ? r->t : map;
+        snprintf(label, sizeof label, step ? "%.50s" : "%.50s (map)", name);
+        snprintf(what, sizeof what, "drum runs at tier '%.31s'", t->name);
+        cal_plan *c = plan_step(p, label, what);
+        for (int w = 0; w < 2; ++w)
+            if (plan_search(r, &pass[w], t, m, step && map, w ? &c->worst : &c->expected, r->err, sizeof r->err)) return 1;
+    }
+    return 0;
+}
+
+// Every step of the calibration (as plan_progress), its expected and worst cost.
 static int plan_cost(run *r, plan *p)
 {
     int parallel = r->env.workers * cal_mpi_size();
     plan_pass pass[2] = {{.worst = 0, .k_n = p->k_expected, .parallel = parallel},
                          {.worst = 1, .k_n = p->k_worst, .parallel = parallel}};
-    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
-    for (int k = 0; k < r->progress.n_stages; ++k) {
-        const cal_progress_stage *s = &r->progress.stage[k];
-        const cal_material *m = NULL;
-        for (unsigned j = 0; j < r->c->materials_count; ++j)
-            if (strncmp(s->name, r->c->materials[j].name, strlen(r->c->materials[j].name)) == 0 &&
-                (s->name[strlen(r->c->materials[j].name)] == 0 || s->name[strlen(r->c->materials[j].name)] == ' '))
-                m = &r->c->materials[j];
-        snprintf(p->name[p->n], sizeof p->name[0], "%s", s->name);
-        cal_plan *c = &p->step[p->n++];
-        for (int w = 0; w < 2; ++w) {
-            cal_plan_cost *cost = w ? &c->worst : &c->expected;
-            if (s->kind == CAL_RUN_CYLINDER) plan_cylinders(r, parallel, cost);
-            else if (s->kind == CAL_RUN_MAP_DRUM) {
-                if (plan_search(r, &pass[w], map, m, 0, cost, r->err, sizeof r->err)) return 1;
-            } else if (plan_search(r, &pass[w], r->t, m, map != NULL, cost, r->err, sizeof r->err)) return 1;
-            add_cost(w ? &p->total.worst : &p->total.expected, cost);
-        }
+    if (wants(r, "stiffness")) {
+        cal_plan *c = plan_step(p, "stiffness", "poured cylinders");
+        plan_cylinders(r, parallel, &c->expected), plan_cylinders(r, parallel, &c->worst);
     }
+    if (wants(r, "granule") && plan_friction_steps(r, p, pass, NULL, "granule")) return 1;
+    for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if ((!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) && plan_friction_steps(r, p, pass, m, m->name))
+            return 1;
+    }
+    for (int k = 0; k < p->n; ++k) add_cost(&p->total.expected, &p->step[k].expected), add_cost(&p->total.worst, &p->step[k].worst);
     return 0;
 }
 
 static void print_plan(const run *r, const plan *p)
 {
     int parallel = r->env.workers * cal_mpi_size();
-    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
     fprintf(stderr, "== plan: tier '%s', %d worker(s); expected (worst case)\n", r->t->name, parallel);
     for (int k = 0; k < p->n; ++k) {
         const cal_plan *c = &p->step[k];
-        const cal_run_kind kind = r->progress.stage[k].kind;
-        char what[96];
-        if (kind == CAL_RUN_CYLINDER) snprintf(what, sizeof what, "poured cylinders");
-        else snprintf(what, sizeof what, "drum runs at tier '%s'", kind == CAL_RUN_MAP_DRUM ? map->name : r->t->name);
         fprintf(stderr, "   %-18s %4d (%4d) %-28s %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", p->name[k], c->expected.runs,
-                c->worst.runs, what, c->expected.core_s / 3600, c->worst.core_s / 3600, c->expected.wall_s / 3600,
+                c->worst.runs, p->what[k], c->expected.core_s / 3600, c->worst.core_s / 3600, c->expected.wall_s / 3600,
                 c->worst.wall_s / 3600);
     }
     char e[128], w[128];
