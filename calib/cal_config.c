@@ -331,6 +331,14 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
     return 0;
 }
 
+// "quick, ci, check, ...": the tiers the config defines, for an error that names a tier it lacks.
+static void tier_names(const cal_config *c, char *out, size_t len)
+{
+    out[0] = 0;
+    for (unsigned k = 0; k < c->tiers_count; ++k)
+        snprintf(out + strlen(out), len - strlen(out), "%s%s", k ? ", " : "", c->tiers[k].name);
+}
+
 static int check_names(const cal_config *c, char *err, size_t len)
 {
     if (strcmp(c->calibration, "drum") != 0) return located(c, 1, "calibration", err, len, "'%s': must be drum", c->calibration);
@@ -344,7 +352,9 @@ static int check_names(const cal_config *c, char *err, size_t len)
         for (unsigned j = 0; j < k; ++j)
             if (strcmp(c->tiers[k].name, c->tiers[j].name) == 0)
                 return located(c, 1, "tiers", err, len, "tier '%s' is defined twice", c->tiers[k].name);
-    if (!cal_config_tier(c)) return located(c, 1, "tier", err, len, "'%s' is not one of the tiers below", c->tier);
+    char names[512];
+    tier_names(c, names, sizeof names);
+    if (!cal_config_tier(c)) return located(c, 1, "tier", err, len, "'%s' is not one of its tiers: %s", c->tier, names);
     return 0;
 }
 
@@ -387,6 +397,12 @@ cal_config *cal_config_load(const char *path, const char *tier_override, char *e
     char copy[1024];
     snprintf(copy, sizeof copy, "%s", path);
     snprintf(c->dir, sizeof c->dir, "%s", dirname(copy));
+    if (tier_override && !cal_config_tier_named(c, tier_override)) { // the user's option, not the file's line
+        char names[512];
+        tier_names(c, names, sizeof names);
+        exp_fail(err, len, "--tier %s: not a tier of %s; its tiers: %s", tier_override, path, names);
+        return cal_config_free(c), NULL;
+    }
     if (tier_override) {
         char *t = strdup(tier_override);
         if (!t) return cal_config_free(c), exp_fail(err, len, "out of memory"), NULL;

@@ -500,7 +500,7 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     for (int c = 0; c < n_cases && !bad; ++c)
         for (int k = 0; k < n && !bad; ++k) {
             cal_drum_key(&cases[c], rpm[k], b.keys[c * n + k], sizeof b.keys[0]);
-            int got = cal_store_get(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
+            int got = cal_store_lookup(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
             bad = got < 0;
             if (got == 1) missing[n_missing++] = (drum_run){c, k};
             if (got == 0) count_stored(env, drum_kind(env), &out[c * n + k]);
@@ -573,7 +573,7 @@ int cal_cylinder_evaluate(cal_env *env, const exp_cylinder_def *cases, int n, ca
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
         cal_cylinder_key(&cases[k], keys[k], sizeof keys[k]);
-        int got = cal_store_get(env->store, keys[k], &out[k], err, len);
+        int got = cal_store_lookup(env->store, keys[k], &out[k], err, len);
         bad = got < 0;
         missing[k] = got == 1;
         if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k, missing[k] = 0;

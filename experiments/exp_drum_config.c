@@ -125,7 +125,13 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     p.wall_mu_s = y->mu_s, p.wall_mu_r = y->mu_r;
     if (strcmp(y->wall, "granules") != 0) {
         const exp_material_yaml *m = find_material(y, y->wall);
-        if (!m) return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
+        if (!m) { // the linings this file defines, so the user can pick one
+            char names[512] = "granules";
+            for (unsigned k = 0; k < y->materials_count; ++k)
+                snprintf(names + strlen(names), sizeof names - strlen(names), ", %s", y->materials[k].name);
+            return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials; the walls are: %s", y->wall,
+                            names);
+        }
         p.wall_mu_s = m->mu_s, p.wall_mu_r = m->mu_r;
     }
     if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &p.fill_method))
