@@ -64,7 +64,8 @@ static const char help[] =
     "  -h, --help           this text\n"
     "\n"
     "Outputs in DIR: fidelity.csv (rung x speed), fidelity_summary.csv (rung),\n"
-    "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png, store/.\n"
+    "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png (or, where every\n"
+    "rung run has one lambda, fidelity_vs_slice_depth.png), store/.\n"
     "Run it again with the same options: stored simulations are not rerun.\n";
 
 enum { MAX_RUNGS = 32, MAX_SPEEDS = 16, MAX_SEEDS = 16 };
