@@ -272,3 +272,24 @@ int cal_figures_friction(const char *dir, const cal_bounds *bounds, const cal_fr
 {
     return angle_map(dir, bounds, r, err, len) || convergence(dir, r, err, len) || csa_vs_rpm(dir, r, err, len);
 }
+
+int cal_figure_posterior(const char *dir, const cal_bounds *bounds, const cal_friction_result *r,
+                         const cal_posterior *p, char *err, size_t len)
+{
+    char path[1200], title[160], note[400];
+    snprintf(path, sizeof path, "%s/posterior_%s.png", dir, stage_name(r));
+    snprintf(title, sizeof title, "%s: posterior of (μs, μr) given the data", stage_name(r));
+    snprintf(note, sizeof note,
+             "median [95 %% credible]\nμs %.2g [%.2g, %.2g]\nμr %.2g [%.2g, %.2g]\n%d samples, %d chains\n"
+             "solid: median\ndashed: 2.5, 97.5 %%\n★ the search's choice",
+             p->median[0], p->lo[0], p->hi[0], p->median[1], p->lo[1], p->hi[1], p->n, CAL_POSTERIOR_CHAINS);
+    const cal_candidate *best = r->best >= 0 ? &r->cand[r->best] : NULL;
+    exp_plot_corner c = {.title = title, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
+                         .n = (size_t)p->n, .x = p->mu_s, .y = p->mu_r,
+                         .xlo = bounds->mu_s_min, .xhi = bounds->mu_s_max, .ylo = bounds->mu_r_min, .yhi = bounds->mu_r_max,
+                         .log_y = 1, .x_median = p->median[0], .x_lo = p->lo[0], .x_hi = p->hi[0],
+                         .y_median = p->median[1], .y_lo = p->lo[1], .y_hi = p->hi[1],
+                         .chosen_x = best ? best->mu_s : NAN, .chosen_y = best ? best->mu_r : NAN,
+                         .chosen_label = "the search's choice", .note = note};
+    return exp_plot_corner_png(path, &c, 1000, 760, err, len);
+}

@@ -1127,3 +1127,131 @@ int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int hei
     free(g);
     return end_figure(&f, err, len);
 }
+
+// ---- corner plots ---------------------------------------------------------------------
+
+enum { CORNER_BINS = 30, CORNER_MAX_POINTS = 4000 };
+
+// Counts of v (world coordinates) in CORNER_BINS bins over [lo, hi], as a
+// fraction of the largest, at each bin's left edge (plbin's layout).
+static void histogram(size_t n, const double *v, int log, double lo, double hi, double *edge, double *height)
+{
+    double count[CORNER_BINS] = {0}, most = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double w = world(v[i], log);
+        if (!isfinite(w)) continue;
+        int b = (int)((w - lo) / (hi - lo) * CORNER_BINS);
+        if (b >= 0 && b <= CORNER_BINS) count[b < CORNER_BINS ? b : CORNER_BINS - 1]++;
+    }
+    for (int b = 0; b < CORNER_BINS; ++b) most = fmax(most, count[b]);
+    for (int b = 0; b < CORNER_BINS; ++b)
+        edge[b] = lo + (hi - lo) * b / CORNER_BINS, height[b] = most > 0 ? count[b] / most : 0;
+}
+
+// A vertical (x) or horizontal (y) line across the current window, dashed or solid.
+static void corner_line(int vertical, double at, int dashed, double w0, double w1)
+{
+    if (!isfinite(at)) return;
+    PLFLT x[2] = {at, at}, y[2] = {w0, w1};
+    pllsty(dashed ? 2 : 1);
+    if (vertical) plline(2, x, y);
+    else plline(2, y, x);
+    pllsty(1);
+}
+
+// One histogram panel: bars along x (vertical = 0: the y histogram drawn sideways).
+static void corner_histogram(const exp_plot_corner *c, int of_y, double lo, double hi)
+{
+    double edge[CORNER_BINS], height[CORNER_BINS];
+    double s0 = of_y ? world(c->ylo, c->log_y) : c->xlo, s1 = of_y ? world(c->yhi, c->log_y) : c->xhi;
+    histogram(c->n, of_y ? c->y : c->x, of_y && c->log_y, s0, s1, edge, height);
+    if (of_y) plwind(0, 1.05, lo, hi);
+    else plwind(lo, hi, 0, 1.05);
+    plcol0(FIRST_SERIES_COLOUR);
+    for (int b = 0; b < CORNER_BINS; ++b) { // each bin a filled box, drawn as the plot's axes run
+        double w = (s1 - s0) / CORNER_BINS;
+        PLFLT bx[4] = {edge[b], edge[b] + w, edge[b] + w, edge[b]}, by[4] = {0, 0, height[b], height[b]};
+        if (of_y) plfill(4, by, bx);
+        else plfill(4, bx, by);
+    }
+    plcol0(INK);
+    double med = of_y ? world(c->y_median, c->log_y) : c->x_median;
+    double q_lo = of_y ? world(c->y_lo, c->log_y) : c->x_lo, q_hi = of_y ? world(c->y_hi, c->log_y) : c->x_hi;
+    corner_line(!of_y, med, 0, 0, 1.05);
+    corner_line(!of_y, q_lo, 1, 0, 1.05);
+    corner_line(!of_y, q_hi, 1, 0, 1.05);
+    plbox(of_y ? "bc" : "bc", 0, 0, of_y ? "bcst" : "bc", 0, 0);
+}
+
+// The joint panel: the samples (at most CORNER_MAX_POINTS, evenly taken), the medians and intervals, the choice.
+static void corner_joint(const exp_plot_corner *c, double x0, double x1, double y0, double y1, int chosen_colour)
+{
+    plwind(x0, x1, y0, y1);
+    grid_lines(0, c->log_y);
+    size_t every = c->n > CORNER_MAX_POINTS ? c->n / CORNER_MAX_POINTS : 1;
+    text_size(0.35);
+    plcol0(FIRST_SERIES_COLOUR);
+    for (size_t i = 0; i < c->n; i += every) {
+        double x = c->x[i], y = world(c->y[i], c->log_y);
+        if (isfinite(x) && isfinite(y)) plstring(1, &x, &y, "•");
+    }
+    text_size(TEXT);
+    plcol0(INK);
+    corner_line(1, c->x_median, 0, y0, y1), corner_line(1, c->x_lo, 1, y0, y1), corner_line(1, c->x_hi, 1, y0, y1);
+    corner_line(0, world(c->y_median, c->log_y), 0, x0, x1);
+    corner_line(0, world(c->y_lo, c->log_y), 1, x0, x1), corner_line(0, world(c->y_hi, c->log_y), 1, x0, x1);
+    double cy = world(c->chosen_y, c->log_y);
+    if (isfinite(c->chosen_x) && isfinite(cy)) map_mark(c->chosen_x, cy, EXP_MARK_STAR, chosen_colour);
+    frame(0, c->log_y, x0, x1, y0, y1);
+}
+
+// The free corner's text, one line under the other from its top.
+static void corner_note(const char *note)
+{
+    if (!note) return;
+    plwind(0, 1, 0, 1);
+    plcol0(INK);
+    text_size(SMALL);
+    char line[256];
+    double at = 0.92;
+    for (const char *p = note; *p; at -= 0.11) {
+        size_t k = strcspn(p, "\n");
+        snprintf(line, sizeof line, "%.*s", (int)(k < 255 ? k : 255), p);
+        plptex(0.02, at, 1, 0, 0, line);
+        p += k + (p[k] == '\n');
+    }
+    text_size(TEXT);
+}
+
+int exp_plot_corner_png(const char *path, const exp_plot_corner *c, int width, int height, char *err, size_t len)
+{
+    figure f;
+    if (begin_figure(&f, path, width, height, err, len)) return 1;
+    enum { CHOSEN = FIRST_SERIES_COLOUR + 1 };
+    double rgb[3];
+    exp_plot_colour(0, rgb);
+    set_colour(FIRST_SERIES_COLOUR, rgb);
+    plscol0(CHOSEN, 215, 25, 28);
+    page p = page_size();
+    double left = 8.0 * p.char_mm, bottom = 4.4 * p.char_mm, top = 3.2 * p.char_mm, right = 2.5 * p.char_mm;
+    double gap = 1.0 * p.char_mm;
+    double a_w = (p.width - left - right - gap) * 0.7, a_h = (p.height - bottom - top - gap) * 0.7;
+    double b_w = p.width - left - right - gap - a_w, b_h = p.height - bottom - top - gap - a_h;
+    // The windows reach 3 % past the support, so that a star on a bound is whole.
+    double y0 = world(c->ylo, c->log_y), y1 = world(c->yhi, c->log_y), pad_y = 0.03 * (y1 - y0);
+    double pad_x = 0.03 * (c->xhi - c->xlo), x0 = c->xlo - pad_x, x1 = c->xhi + pad_x;
+    y0 -= pad_y, y1 += pad_y;
+    plsvpa(left, left + a_w, bottom, bottom + a_h); // joint, below left
+    corner_joint(c, x0, x1, y0, y1, CHOSEN);
+    plcol0(INK);
+    plmtex("b", 3.2, 0.5, 0.5, c->xlabel);
+    plmtex("l", ylabel_offset(), 0.5, 0.5, c->ylabel);
+    plsvpa(left, left + a_w, bottom + a_h + gap, bottom + a_h + gap + b_h); // x histogram above
+    corner_histogram(c, 0, x0, x1);
+    if (c->title) text_size(TITLE), plmtex("t", 1.2, 0.0, 0.0, c->title), text_size(TEXT);
+    plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom, bottom + a_h); // y histogram to the right
+    corner_histogram(c, 1, y0, y1);
+    plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom + a_h + gap, bottom + a_h + gap + b_h);
+    corner_note(c->note);
+    return end_figure(&f, err, len);
+}

@@ -124,6 +124,27 @@ size_t exp_plot_place_labels(size_t n, const double *px, const double *py, const
 /// n == 0). An axis to a little past it shows the event, not the wait after it.
 double exp_plot_settled_from(size_t n, const double *t, const double *y, double tolerance);
 
+/// A corner plot of samples of two parameters (a posterior): the joint
+/// scatter below left, each one's histogram beside it (x above, y to the
+/// right), each median a solid line and its interval dashed, the search's
+/// choice starred, and a note in the free corner. The axes are the prior's
+/// support (the search's bounds).
+typedef struct exp_plot_corner {
+    const char *title, *xlabel, *ylabel;
+    size_t n;
+    const double *x, *y;       ///< the samples
+    double xlo, xhi, ylo, yhi; ///< the axes: the support
+    int log_y;                 ///< y (and its histogram) in log10
+    double x_median, x_lo, x_hi, y_median, y_lo, y_hi;
+    double chosen_x, chosen_y; ///< starred; non-finite: none
+    const char *chosen_label;  ///< the star's legend text
+    const char *note;          ///< text in the free corner ('\n' between lines), or NULL
+} exp_plot_corner;
+
+/// Write a corner plot as a PNG of `width` × `height` pixels. 0 on success,
+/// else non-zero with a message naming the file.
+int exp_plot_corner_png(const char *path, const exp_plot_corner *c, int width, int height, char *err, size_t len);
+
 /// A colour of a small qualitative palette (k wraps around).
 void exp_plot_colour(int k, double rgb[3]);
 
