@@ -234,6 +234,52 @@ double dem_gsd_quantile(const dem_gsd *g, double p)
     return g->median_diameter * pow(g->geometric_sd, fmin(fmax(z, -t), t));
 }
 
+// A table's classes holding granules, merged into at most `max` groups of
+// consecutive classes: a group's fraction the sum, its mean d³ the
+// fraction-weighted mean of its classes'.
+static int table_classes(const dem_gsd_table *t, int max, double *diameter, double *fraction)
+{
+    int held = 0;
+    for (int i = 1; i < t->rows; i++) held += t->cumulative[i] > t->cumulative[i - 1];
+    const int groups = held < max ? held : max;
+    int k = 0, seen = 0;
+    double p = 0.0, cube = 0.0;
+    for (int i = 1; i < t->rows; i++) {
+        const double share = t->cumulative[i] - t->cumulative[i - 1];
+        if (!(share > 0.0)) continue;
+        p += share, cube += share * class_mean_cube(t->diameter[i - 1], t->diameter[i]);
+        // Group k holds the classes up to the (k+1)/groups share of the held ones.
+        if (++seen * groups >= (k + 1) * held) {
+            fraction[k] = p, diameter[k] = cbrt(cube / p);
+            k++, p = 0.0, cube = 0.0;
+        }
+    }
+    return k;
+}
+
+// E[d³ | class] of the truncated log-normal for z in [z0, z1]: complete the
+// square as in truncated_moment.
+static int lognormal_classes(const dem_gsd *g, int max, double *diameter, double *fraction)
+{
+    const double s = log(g->geometric_sd), t = g->truncation_sigmas;
+    if (!(s > 0.0)) return diameter[0] = g->median_diameter, fraction[0] = 1.0, 1;
+    const double kept = gsl_cdf_ugaussian_P(t) - gsl_cdf_ugaussian_P(-t), width = 2.0 * t / max;
+    for (int k = 0; k < max; k++) {
+        const double z0 = -t + k * width, z1 = z0 + width;
+        const double n = gsl_cdf_ugaussian_P(z1) - gsl_cdf_ugaussian_P(z0);
+        const double m3 = exp(4.5 * s * s) * (gsl_cdf_ugaussian_P(z1 - 3 * s) - gsl_cdf_ugaussian_P(z0 - 3 * s)) / n;
+        diameter[k] = g->median_diameter * cbrt(m3), fraction[k] = n / kept;
+    }
+    return max;
+}
+
+int dem_gsd_classes(const dem_gsd *g, int max, double *diameter, double *fraction)
+{
+    if (dem_gsd_check(g, NULL, 0) != 0 || max < 1 || !diameter || !fraction) return 0;
+    if (g->table.rows) return table_classes(&g->table, max, diameter, fraction);
+    return lognormal_classes(g, max, diameter, fraction);
+}
+
 uint64_t dem_gsd_table_fingerprint(const dem_gsd *g)
 {
     // FNV-1a over the rows' bytes: the same table, bit for bit, the same key.

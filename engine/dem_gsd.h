@@ -69,6 +69,17 @@ int dem_gsd_from_table(const double *diameter, const double *cumulative_percent,
 /// (the number distribution's quantile), m; NaN for an invalid GSD or p.
 double dem_gsd_quantile(const dem_gsd *g, double p);
 
+/// The distribution in at most `max` size classes, for a deck that inserts
+/// granules class by class (LIGGGHTS particletemplate/particledistribution,
+/// LAMMPS fix pour): each class's number fraction (summing to 1) and the
+/// diameter of its mean granule volume, cbrt(E[d³ | class]), so that granules
+/// drawn from the classes carry the distribution's mean volume. A log-normal:
+/// `max` classes equally wide in ln d over the truncated range. A table: its
+/// own classes (rows) holding granules, consecutive ones merged into `max`
+/// groups when there are more. Returns the number of classes, 0 for an
+/// invalid GSD or max < 1.
+int dem_gsd_classes(const dem_gsd *g, int max, double *diameter, double *fraction);
+
 /// A 64-bit fingerprint of a table's rows (0 without a table): part of a
 /// stored simulation's key, so that another table is another simulation.
 uint64_t dem_gsd_table_fingerprint(const dem_gsd *g);

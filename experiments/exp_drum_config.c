@@ -117,7 +117,7 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     *run = exp_default_drum_run_opts();
     exp_drum_physics p = {.diameter = y->diameter, .periodic = y->periodic, .depth = y->depth,
                           .slice_depth = y->slice_depth, .fill = y->fill, .lambda = y->lambda,
-                          .gsd = {y->median_diameter, y->geometric_sd, y->truncation_sigmas},
+                          .gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas),
                           .density = y->density, .k_n = y->k_n, .xi = y->xi, .mu_s = y->mu_s, .mu_r = y->mu_r,
                           .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)y->seed};
     if (exp_damping_from_name(y->damping, "damping", &p.damping, err, len)) return 1;

@@ -381,6 +381,39 @@ static void test_table_volume_scaling_determinism(void **state)
     free(a), free(b);
 }
 
+// Classes for a deck's insertion: fractions sum to 1 and the classes carry
+// the distribution's mean volume, for a log-normal and for a table (its own
+// classes, and merged into fewer).
+static void expect_classes(const dem_gsd *g, int max, int want_n)
+{
+    double d[64], p[64], sum = 0.0, volume = 0.0;
+    int n = dem_gsd_classes(g, max, d, p);
+    assert_int_equal(n, want_n);
+    for (int k = 0; k < n; k++) {
+        sum += p[k], volume += p[k] * M_PI / 6.0 * d[k] * d[k] * d[k];
+        assert_true(d[k] >= dem_gsd_min_diameter(g) && d[k] <= dem_gsd_max_diameter(g));
+        if (k) assert_true(d[k] > d[k - 1]);
+    }
+    assert_rel(sum, 1.0, 1e-12, "class fractions sum to 1");
+    assert_rel(volume, dem_gsd_mean_volume(g), 1e-9, "classes carry the mean volume");
+}
+
+static void test_classes(void **state)
+{
+    (void)state;
+    dem_gsd lognormal = dem_default_gsd();
+    expect_classes(&lognormal, 12, 12);
+    double d[40], pct[40];
+    lognormal_table(293.6e-6, 1.43, -3.0, 3.0, 40, d, pct);
+    dem_gsd g;
+    int row;
+    char msg[256];
+    assert_int_equal(dem_gsd_from_table(d, pct, 40, DEM_GSD_VOLUME, &g, &row, msg, sizeof msg), 0);
+    expect_classes(&g, 64, 39);
+    expect_classes(&g, 10, 10);
+    assert_int_equal(dem_gsd_classes(&g, 0, d, pct), 0);
+}
+
 // A table `rows` long with one value replaced must be refused at that row,
 // naming the field.
 static void expect_bad_row(int rows, int at, double size_um, double percent, int want_row, const char *field)
@@ -463,7 +496,7 @@ int main(void)
         cmocka_unit_test(test_bad_parameters),
         cmocka_unit_test(test_number_table_is_its_lognormal), cmocka_unit_test(test_volume_table_hatch_choate),
         cmocka_unit_test(test_table_volume_scaling_determinism), cmocka_unit_test(test_bad_tables),
-        cmocka_unit_test(test_table_file),
+        cmocka_unit_test(test_table_file), cmocka_unit_test(test_classes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
