@@ -53,6 +53,11 @@ expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perh
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
 expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm 's/^    max_time: 1.5/    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
+# A measured size table (gsd_table): its rows checked and named; not with the log-normal's keys; its basis required.
+printf 'size_um,cumulative_percent\n100,0\n200,40\n300,30\n400,100\n' > "$work/configs/psd.csv"
+expect "size table decreasing" "psd.csv:4: cumulative_percent: 30 is below the row above (40)" -- "$(edit psd 's/^median_diameter: .*/gsd_table: psd.csv\ngsd_basis: volume/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
+expect "size table and log-normal" "median_diameter: gsd_table gives the size distribution" -- "$(edit psd_both 's/^density: 1800 .*/density: 1800\ngsd_table: psd.csv\ngsd_basis: volume/')" "${out[@]}"
+expect "size table without basis" "gsd_basis: 'absent'" -- "$(edit psd_basis 's/^median_diameter: .*/gsd_table: psd.csv/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
 expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
 expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
