@@ -6,7 +6,8 @@
 # block that fails, naming its line in the guide; then checks that what the guide tells the reader
 # to read was written.
 #
-#   guide.sh GRANUCAL SRC [WORK [GUIDE]]     # WORK: default a new temporary folder (kept on failure)
+#   guide.sh GRANUCAL SRC [WORK [GUIDE]]     # WORK: default a new temporary folder (kept on failure,
+#                                            # and on success with GUIDE_KEEP=1)
 set -euo pipefail
 granucal=$(realpath "$1") src=$(realpath "$2")
 work=${3:-$(mktemp -d /tmp/guide.XXXXXX)}
@@ -48,8 +49,14 @@ done
 # The guide measures both linings at both speeds: 2 angle rows (the angle speed) and 4 CSA rows.
 [ "$(grep -c ',4,' "$work/repose_angle.csv" || true)" = 2 ] || { echo "FAIL: repose_angle.csv lacks a lining's 4 rpm row"; fails=$((fails + 1)); }
 [ "$(grep -cE ',(4|40),' "$work/occupied_area.csv" || true)" = 4 ] || { echo "FAIL: occupied_area.csv lacks rows"; fails=$((fails + 1)); }
-# The run sampled the table: its simulations are keyed by it (a log-normal run's key has no gsd_table).
 grep -q 'steel' "$work/run_tiny/calibrated_parameters.csv" || { echo "FAIL: no steel row in the table"; fails=$((fails + 1)); }
-if [ "$fails" = 0 ]; then rm -rf "$work"; echo "guide: every block ran"; fi
+# The run drew its granules from the table: every stored simulation's key names it (a log-normal's does not).
+records=$(ls "$work"/run_tiny/store/*.yaml 2>/dev/null | wc -l)
+keyed=$(grep -l "^key: .* gsd_table=18:" "$work"/run_tiny/store/*.yaml 2>/dev/null | wc -l)
+[ "$records" -gt 0 ] && [ "$keyed" = "$records" ] || { echo "FAIL: $keyed of $records stored simulations keyed by the 18-row size table"; fails=$((fails + 1)); }
+if [ "$fails" = 0 ]; then
+    echo "guide: every block ran"
+    [ "${GUIDE_KEEP:-0}" = 1 ] || rm -rf "$work"
+fi
 echo "$fails failure(s)"
 [ "$fails" = 0 ]
