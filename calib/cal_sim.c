@@ -33,7 +33,7 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     // A tier with a slice depth runs a periodic slice of the config's drum.
     exp_drum_physics p = {.diameter = c->diameter, .periodic = t->slice_depth > 0, .depth = c->depth,
                           .slice_depth = t->slice_depth, .fill = c->fill, .lambda = t->lambda,
-                          .gsd = {c->median_diameter, c->geometric_sd, c->truncation_sigmas},
+                          .gsd = c->gsd,
                           .density = c->density, .k_n = k_n, .xi = c->xi, .damping = config_damping(c),
                           .mu_s = gg_mu_s, .mu_r = gg_mu_r, .wall_mu_s = wall_mu_s, .wall_mu_r = wall_mu_r,
                           .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)c->seed};
@@ -70,7 +70,7 @@ exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, 
 {
     exp_cylinder_def d = exp_default_cylinder_def();
     d.lambda = t->cylinder_lambda, d.density = c->density, d.seed = seed;
-    d.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
+    d.gsd = c->gsd;
     // Stage 1 comes before the friction is known: the pour uses the config's
     // stated prior friction (pour_mu_s, pour_mu_r). The stage reads how the
     // coordination number moves with k, not its level.
@@ -83,6 +83,15 @@ static void contact_text(char *out, size_t len, const dem_contact_params *p)
 {
     snprintf(out, len, "k=%.10g,%.10g,%.10g xi=%.10g mu=%.10g,%.10g damping=%d", p->k_n, p->k_s, p->k_r, p->xi,
              p->mu_s, p->mu_r, (int)p->damping);
+}
+
+// A measured size table is named by its fingerprint, only when there is one,
+// so that every log-normal run keeps its key.
+static void gsd_table_text(const dem_gsd *g, char *out, size_t len)
+{
+    if (g->table.rows)
+        snprintf(out + strlen(out), len - strlen(out), " gsd_table=%d:%016llx", g->table.rows,
+                 (unsigned long long)dem_gsd_table_fingerprint(g));
 }
 
 static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
@@ -99,6 +108,7 @@ static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
     // Named only when not the pour, so that the stores of every pour run keep their keys.
     if (d->fill_method != EXP_FILL_POUR)
         snprintf(out + strlen(out), len - strlen(out), " fill_method=%s", exp_drum_fill_method_name(d->fill_method));
+    gsd_table_text(&d->gsd, out, len);
 }
 
 exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm)
@@ -138,6 +148,7 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
                        "wall[%s] seed=%llu",
              exp_results_version(), c->diameter, c->depth, c->lambda, c->density, c->gsd.median_diameter, c->gsd.geometric_sd,
              c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
+    gsd_table_text(&c->gsd, out, len);
 }
 
 // "[stage] what: status (reason), angle ..., CSA ... — T s simulated in W s; ENDING"

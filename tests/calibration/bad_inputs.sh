@@ -59,6 +59,11 @@ expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its
 expect "unknown tier in the file" "good_tier.yaml:$(grep -n '^tier:' "$work/configs/good.yaml" | cut -d: -f1): tier: 'fast' is not one of its tiers: $tiers" -- "$(edit good_tier 's/^tier: quick/tier: fast/')" "${out[@]}"
 cmd=synthesize expect "synthesize: unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 cmd=study expect "study: unknown rung" "--rungs L1000-slice9-avg8,L3-full: 'L3-full' is not a rung of $work/configs/good.yaml (fidelity.rungs); its rungs: L65536-slice40, " -- fidelity "$work/configs/good.yaml" --rungs L1000-slice9-avg8,L3-full "${out[@]}"
+# A measured size table (gsd_table): its rows checked and named; not with the log-normal's keys; its basis required.
+printf 'size_um,cumulative_percent\n100,0\n200,40\n300,30\n400,100\n' > "$work/configs/psd.csv"
+expect "size table decreasing" "psd.csv:4: cumulative_percent: 30 is below the row above (40)" -- "$(edit psd 's/^median_diameter: .*/gsd_table: psd.csv\ngsd_basis: volume/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
+expect "size table and log-normal" "median_diameter: gsd_table gives the size distribution" -- "$(edit psd_both 's/^density: 1800 .*/density: 1800\ngsd_table: psd.csv\ngsd_basis: volume/')" "${out[@]}"
+expect "size table without basis" "gsd_basis: 'absent'" -- "$(edit psd_basis 's/^median_diameter: .*/gsd_table: psd.csv/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
 expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
 expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
 expect "empty CSV" "empty.csv:1: header" -- "$(csv empty '')" "${out[@]}"
