@@ -13,6 +13,7 @@
 
 #include "dem_contact.h"
 #include "exp_common.h"
+#include "exp_gsd_table.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
 
@@ -101,9 +102,12 @@ static const cyaml_schema_field_t config_fields[] = {
     CFG_STRING("repose_angle", repose_angle, CYAML_FLAG_DEFAULT, 1000),
     CFG_STRING("occupied_area", occupied_area, CYAML_FLAG_DEFAULT, 1000),
     CFG_FLOAT("density", density, CYAML_FLAG_DEFAULT),
-    CFG_FLOAT("median_diameter", median_diameter, CYAML_FLAG_DEFAULT),
-    CFG_FLOAT("geometric_sd", geometric_sd, CYAML_FLAG_DEFAULT),
-    CFG_FLOAT("truncation_sigmas", truncation_sigmas, CYAML_FLAG_DEFAULT),
+    // The size distribution: a log-normal (these three) or a measured table (check_gsd).
+    CFG_FLOAT("median_diameter", median_diameter, CYAML_FLAG_OPTIONAL),
+    CFG_FLOAT("geometric_sd", geometric_sd, CYAML_FLAG_OPTIONAL),
+    CFG_FLOAT("truncation_sigmas", truncation_sigmas, CYAML_FLAG_OPTIONAL),
+    CFG_STRING("gsd_table", gsd_table, CYAML_FLAG_OPTIONAL, 1000),
+    CFG_STRING("gsd_basis", gsd_basis, CYAML_FLAG_OPTIONAL, 16),
     CFG_FLOAT("xi", xi, CYAML_FLAG_DEFAULT),
     CFG_STRING("damping", damping, CYAML_FLAG_OPTIONAL, 32),
     CFG_FLOAT("diameter", diameter, CYAML_FLAG_DEFAULT),
@@ -335,6 +339,14 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
     return 0;
 }
 
+// "quick, ci, check, ...": the tiers the config defines, for an error that names a tier it lacks.
+static void tier_names(const cal_config *c, char *out, size_t len)
+{
+    out[0] = 0;
+    for (unsigned k = 0; k < c->tiers_count; ++k)
+        snprintf(out + strlen(out), len - strlen(out), "%s%s", k ? ", " : "", c->tiers[k].name);
+}
+
 static int check_names(const cal_config *c, char *err, size_t len)
 {
     if (strcmp(c->calibration, "drum") != 0) return located(c, 1, "calibration", err, len, "'%s': must be drum", c->calibration);
@@ -348,21 +360,63 @@ static int check_names(const cal_config *c, char *err, size_t len)
         for (unsigned j = 0; j < k; ++j)
             if (strcmp(c->tiers[k].name, c->tiers[j].name) == 0)
                 return located(c, 1, "tiers", err, len, "tier '%s' is defined twice", c->tiers[k].name);
-    if (!cal_config_tier(c)) return located(c, 1, "tier", err, len, "'%s' is not one of the tiers below", c->tier);
+    char names[512];
+    tier_names(c, names, sizeof names);
+    if (!cal_config_tier(c)) return located(c, 1, "tier", err, len, "'%s' is not one of its tiers: %s", c->tier, names);
     return 0;
 }
 
-static int validate(const cal_config *c, char *err, size_t len)
+// The log-normal's three keys, each in its range (absent reads as 0).
+static int check_lognormal(const cal_config *c, char *err, size_t len)
+{
+    static const char OR_TABLE[] = "(absent reads as 0; or give gsd_table, a measured size table)";
+    if (bad_positive(c->median_diameter))
+        return located(c, 1, "median_diameter", err, len, "%g must be > 0 %s", c->median_diameter, OR_TABLE);
+    if (!(c->geometric_sd >= 1 && c->geometric_sd < 5))
+        return located(c, 1, "geometric_sd", err, len, "%g must be in [1, 5) %s", c->geometric_sd, OR_TABLE);
+    if (!(c->truncation_sigmas > 0 && c->truncation_sigmas <= 4))
+        return located(c, 1, "truncation_sigmas", err, len, "%g must be in (0, 4] %s", c->truncation_sigmas, OR_TABLE);
+    return 0;
+}
+
+// The size distribution, into c->gsd: a log-normal by number, or a measured
+// table (gsd_table, on gsd_basis; exp_gsd_table.h), not both. With a table,
+// median_diameter and geometric_sd become the table's (number-based) values,
+// for what reads a typical diameter.
+static int check_gsd(cal_config *c, char *err, size_t len)
+{
+    if (!c->gsd_table) {
+        if (c->gsd_basis) return located(c, 1, "gsd_basis", err, len, "given without gsd_table");
+        if (check_lognormal(c, err, len)) return 1;
+        c->gsd = dem_gsd_lognormal(c->median_diameter, c->geometric_sd, c->truncation_sigmas);
+        return 0;
+    }
+    const struct { const char *field; double v; } lognormal[] = {
+        {"median_diameter", c->median_diameter}, {"geometric_sd", c->geometric_sd},
+        {"truncation_sigmas", c->truncation_sigmas}};
+    for (size_t k = 0; k < sizeof lognormal / sizeof *lognormal; ++k)
+        if (lognormal[k].v != 0)
+            return located(c, 1, lognormal[k].field, err, len,
+                           "gsd_table gives the size distribution: remove the log-normal's keys (give one or the other)");
+    dem_gsd_basis basis;
+    if (exp_gsd_basis_from_name(c->gsd_basis, &basis))
+        return located(c, 1, "gsd_basis", err, len, "'%s': say what the table's percentages count: volume (laser "
+                       "diffraction, sieving) or number", c->gsd_basis ? c->gsd_basis : "absent");
+    char path[2048];
+    cal_config_data_path(c, c->gsd_table, path, sizeof path);
+    if (exp_gsd_table_load(path, c->gsd_basis, &c->gsd, err, len)) return 1;
+    c->median_diameter = c->gsd.median_diameter, c->geometric_sd = c->gsd.geometric_sd;
+    c->truncation_sigmas = c->gsd.truncation_sigmas;
+    return 0;
+}
+
+static int validate(cal_config *c, char *err, size_t len)
 {
     struct { const char *field; double v; } positive[] = {
-        {"density", c->density}, {"median_diameter", c->median_diameter}, {"diameter", c->diameter},
-        {"depth", c->depth}, {"k_n", c->k_n}};
+        {"density", c->density}, {"diameter", c->diameter}, {"depth", c->depth}, {"k_n", c->k_n}};
     for (size_t k = 0; k < sizeof positive / sizeof *positive; ++k)
         if (bad_positive(positive[k].v)) return located(c, 1, positive[k].field, err, len, "%g must be > 0", positive[k].v);
-    if (!(c->geometric_sd >= 1 && c->geometric_sd < 5))
-        return located(c, 1, "geometric_sd", err, len, "%g must be in [1, 5)", c->geometric_sd);
-    if (!(c->truncation_sigmas > 0 && c->truncation_sigmas <= 4))
-        return located(c, 1, "truncation_sigmas", err, len, "%g must be in (0, 4]", c->truncation_sigmas);
+    if (check_gsd(c, err, len)) return 1;
     if (!(c->xi >= 0 && c->xi <= 1)) return located(c, 1, "xi", err, len, "%g must be in [0, 1]", c->xi);
     if (!(c->fill > 0 && c->fill < 1)) return located(c, 1, "fill", err, len, "%g must be in (0, 1)", c->fill);
     if (!(c->granule_mu_s >= 0 && c->granule_mu_s <= 10))
@@ -391,6 +445,12 @@ cal_config *cal_config_load(const char *path, const char *tier_override, char *e
     char copy[1024];
     snprintf(copy, sizeof copy, "%s", path);
     snprintf(c->dir, sizeof c->dir, "%s", dirname(copy));
+    if (tier_override && !cal_config_tier_named(c, tier_override)) { // the user's option, not the file's line
+        char names[512];
+        tier_names(c, names, sizeof names);
+        exp_fail(err, len, "--tier %s: not a tier of %s; its tiers: %s", tier_override, path, names);
+        return cal_config_free(c), NULL;
+    }
     if (tier_override) {
         char *t = strdup(tier_override);
         if (!t) return cal_config_free(c), exp_fail(err, len, "out of memory"), NULL;

@@ -9,6 +9,7 @@
 
 #include <stddef.h>
 #include "cal_multifidelity.h"
+#include "dem_gsd.h"
 
 /// A wall material to fit: its name in the table and its drum lining's name
 /// in the lab data files.
@@ -134,7 +135,11 @@ typedef struct cal_fidelity {
 typedef struct cal_config {
     char *calibration;                 ///< "drum"
     char *repose_angle, *occupied_area; ///< lab data, relative to the config file
+    /// The log-normal GSD by number (absent with gsd_table; then the table's
+    /// number median and geometric sd, derived on load; truncation 0).
     double density, median_diameter, geometric_sd, truncation_sigmas, xi;
+    char *gsd_table;                   ///< measured size table (CSV, exp_gsd_table.h), relative to the config file
+    char *gsd_basis;                   ///< what its percentages count: "volume" or "number"
     char *damping;
     double diameter, depth, fill;
     char *granule_surface;             ///< the granule-lined drum's name in the data files
@@ -153,6 +158,7 @@ typedef struct cal_config {
     int seed;
     cal_fidelity *fidelity;            ///< optional: the fidelity study
     // Derived on load:
+    dem_gsd gsd;                       ///< the size distribution the simulations sample
     char dir[1024];                    ///< directory of the config file
     char path[1024];
 } cal_config;

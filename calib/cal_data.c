@@ -135,10 +135,22 @@ static int blank_or_comment(const char *line)
     return *line == '#' || *line == '\n' || *line == '\0';
 }
 
+// A comment line that says the numbers are synthetic, and at what lambda.
+static void read_provenance(const char *line, cal_series *s)
+{
+    if (!strstr(line, "SYNTHETIC")) return;
+    s->synthetic = 1;
+    const char *at = strstr(line, "lambda ");
+    char *end = NULL;
+    double lambda = at ? strtod(at + 7, &end) : NAN;
+    if (at && end != at + 7 && lambda > 0 && !isfinite(s->synthetic_lambda)) s->synthetic_lambda = lambda;
+}
+
 int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *err, size_t len)
 {
     memset(s, 0, sizeof *s);
     snprintf(s->path, sizeof s->path, "%s", path);
+    s->synthetic_lambda = NAN;
     FILE *f = fopen(path, "r");
     if (!f) return exp_fail(err, len, "%s: cannot open: %s", path, strerror(errno));
     struct csv_parser p;
@@ -158,7 +170,7 @@ int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *e
             break;
         }
         if (blank_or_comment(line)) {
-            s->synthetic |= strstr(line, "SYNTHETIC") != NULL;
+            read_provenance(line, s);
             continue;
         }
         if (csv_parse(&p, line, (size_t)n, on_field, on_row, &r) != (size_t)n && !r.failed)

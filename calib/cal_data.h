@@ -24,7 +24,15 @@ typedef struct cal_series {
     cal_point *points;
     size_t count;
     int synthetic;    ///< 1 if a comment line says SYNTHETIC: simulated data, not the lab's
+    double synthetic_lambda; ///< the scale factor "lambda N" a SYNTHETIC line names (NAN: none)
 } cal_series;
+
+/// What a figure says of a data file's numbers (cal_series.synthetic and
+/// synthetic_lambda), kept with the stage's result.
+typedef struct cal_provenance {
+    int synthetic;
+    double lambda; ///< NAN: not named
+} cal_provenance;
 
 typedef enum cal_data_kind { CAL_DATA_ANGLE, CAL_DATA_CSA } cal_data_kind;
 

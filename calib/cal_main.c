@@ -44,6 +44,6 @@ int main(int argc, char **argv)
     if (strcmp(argv[1], "--version") == 0) return printf("granucal %s\n", exp_version()), 0;
     for (size_t k = 0; k < sizeof commands / sizeof *commands; ++k)
         if (strcmp(argv[1], commands[k].name) == 0) return commands[k].run(argc - 1, argv + 1);
-    fprintf(stderr, "granucal: unknown command '%s'\n\n%s", argv[1], main_help);
+    fprintf(stderr, "granucal: unknown command '%s'; see `granucal --help`\n", argv[1]);
     return 2;
 }

@@ -13,6 +13,7 @@
 
 #include "cal_commands.h"
 #include "cal_data.h"
+#include "cal_util.h"
 #include "exp_photo.h"
 
 static const char measure_help[] =
@@ -42,9 +43,10 @@ static const char measure_help[] =
     "refused: a message, and exit status 1.\n"
     "\n"
     "Prints one JSON object per photo; with several photos, one more with their mean\n"
-    "and standard deviation. --mask OUT writes the photo with the powder tinted, the\n"
-    "circle, the surface points used and the line (several photos: OUT is a\n"
-    "directory, one mask per photo under the photo's file name).\n"
+    "and standard deviation; a number it does not have is null (the spread of one\n"
+    "photo). --mask OUT writes the photo with the powder tinted, the circle, the\n"
+    "surface points used and the line (several photos: OUT is a directory, one mask\n"
+    "per photo under the photo's file name).\n"
     "\n"
     "From a video of the drum to the calibration's input files:\n"
     "  ffmpeg -i run.mp4 -vf fps=2 frames/%%04d.png     # (crop first if the drum is small)\n"
@@ -85,7 +87,7 @@ static int parse_number(const char *s, double *out)
 
 static int usage(const char *why)
 {
-    fprintf(stderr, "granucal measure: %s\n(granucal measure --help)\n", why);
+    fprintf(stderr, "granucal measure: %s; see `granucal measure --help`\n", why);
     return 2;
 }
 
@@ -105,7 +107,8 @@ static int parse_args(int argc, char **argv, measure_args *a)
         {0}};
     double cx = NAN, cy = NAN, radius = NAN;
     int c;
-    while ((c = getopt_long(argc, argv, "c:r:idk:m:h", opts, NULL)) != -1) {
+    optind = 1, opterr = 0;
+    while ((c = getopt_long(argc, argv, ":c:r:idk:m:h", opts, NULL)) != -1) {
         char *end = NULL;
         if (c == 'h') return printf(measure_help), -1;
         if (c == 'c' && parse_pair(optarg, &cx, &cy)) return usage("--center X,Y: two numbers");
@@ -122,7 +125,7 @@ static int parse_args(int argc, char **argv, measure_args *a)
         if (c == OPT_SKIP) a->skip_refused = 1;
         if (c == OPT_MAX_SD && (parse_number(optarg, &a->opts.max_sd_fraction) || !(a->opts.max_sd_fraction > 0)))
             return usage("--max-sd F: a positive fraction of the drum radius");
-        if (c == '?') return 2;
+        if (c == '?' || c == ':') return cal_option_error("measure", c, argv);
     }
     if (optind >= argc) return usage("no photo given");
     if (isnan(cx) != isnan(radius)) return usage("--center and --radius go together (or neither: the drum is found)");
@@ -144,18 +147,33 @@ static void print_json_string(const char *s)
     putchar('"');
 }
 
+// A JSON number with `decimals` decimals, or null where there is none (JSON
+// has no NaN or infinity: a spread of one photo, a mean of none).
+static void print_json_number(const char *before, double v, int decimals)
+{
+    fputs(before, stdout);
+    if (isfinite(v)) printf("%.*f", decimals, v);
+    else fputs("null", stdout);
+}
+
 static void print_result(const char *photo, const exp_photo_result *r, int given, int closing, int found)
 {
     printf("{\"photo\": ");
     print_json_string(photo);
-    if (found)
-        printf(", \"angle_deg\": %.3f, \"angle_signed_deg\": %.3f, \"surface_fit_sd_px\": %.3f, \"surface_points\": %d",
-               fabs(r->angle_deg), r->angle_deg, r->surface_sd_px, r->surface_points);
-    else printf(", \"angle_deg\": null");
-    printf(", \"csa_percent\": %.3f, \"center\": [%.2f, %.2f], \"radius\": %.2f, \"circle\": \"%s\", "
-           "\"circle_support\": %.2f, \"powder\": \"%s\", \"closing_px\": %d, \"surface_found\": %s}\n",
-           r->csa_percent, r->circle.cx, r->circle.cy, r->circle.r, given ? "given, refined" : "found",
-           r->circle.support, r->powder_dark ? "dark" : "light", closing, found ? "true" : "false");
+    if (found) {
+        print_json_number(", \"angle_deg\": ", fabs(r->angle_deg), 3);
+        print_json_number(", \"angle_signed_deg\": ", r->angle_deg, 3);
+        print_json_number(", \"surface_fit_sd_px\": ", r->surface_sd_px, 3);
+        printf(", \"surface_points\": %d", r->surface_points);
+    } else printf(", \"angle_deg\": null");
+    print_json_number(", \"csa_percent\": ", r->csa_percent, 3);
+    print_json_number(", \"center\": [", r->circle.cx, 2);
+    print_json_number(", ", r->circle.cy, 2);
+    print_json_number("], \"radius\": ", r->circle.r, 2);
+    printf(", \"circle\": \"%s\"", given ? "given, refined" : "found");
+    print_json_number(", \"circle_support\": ", r->circle.support, 2);
+    printf(", \"powder\": \"%s\", \"closing_px\": %d, \"surface_found\": %s}\n", r->powder_dark ? "dark" : "light",
+           closing, found ? "true" : "false");
 }
 
 static int write_mask(const measure_args *a, const char *photo, int several, const exp_photo_result *r)
@@ -256,10 +274,12 @@ static int write_rows(const measure_args *a, const frame_stats *s)
 
 static void print_summary(const frame_stats *s)
 {
-    printf("{\"frames\": %d, \"measured\": %d, \"angle_deg\": %.3f, \"angle_sd_deg\": %.3f, \"csa_percent\": %.3f, "
-           "\"csa_sd_percent\": %.3f}\n",
-           s->frames, s->measured, mean_of(s->angle_sum, s->measured), sd_of(s->angle_sum, s->angle_sq, s->measured),
-           mean_of(s->csa_sum, s->measured), sd_of(s->csa_sum, s->csa_sq, s->measured));
+    printf("{\"frames\": %d, \"measured\": %d", s->frames, s->measured);
+    print_json_number(", \"angle_deg\": ", mean_of(s->angle_sum, s->measured), 3);
+    print_json_number(", \"angle_sd_deg\": ", sd_of(s->angle_sum, s->angle_sq, s->measured), 3);
+    print_json_number(", \"csa_percent\": ", mean_of(s->csa_sum, s->measured), 3);
+    print_json_number(", \"csa_sd_percent\": ", sd_of(s->csa_sum, s->csa_sq, s->measured), 3);
+    puts("}");
 }
 
 int cal_cmd_measure(int argc, char **argv)

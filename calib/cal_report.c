@@ -608,6 +608,19 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
     return cal_atomic_commit(&a, err, len);
 }
 
+static int write_figures(const char *dir, const cal_outcome *o, const posteriors *post, char *err, size_t len)
+{
+    if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
+    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+        const cal_friction_result *r = stage_of(o, i);
+        const cal_bounds *b = i ? &o->config->wall : &o->config->granule;
+        if (!r) continue;
+        if (cal_figures_friction(dir, b, r, err, len)) return 1;
+        if (post->ok[i] && cal_figure_posterior(dir, b, r, &post->of[i], err, len)) return 1;
+    }
+    return 0;
+}
+
 int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t len)
 {
     cal_table_row rows[CAL_TABLE_MAX_ROWS];
@@ -622,12 +635,8 @@ int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t le
               write_table_h5(dir, o, rows, n, err, len) || cal_export_write(dir, o, err, len) ||
               write_simulations(dir, store, o, &tally, err, len) || write_report(dir, o, post, &tally, err, len);
     free(tally.hash);
+    bad = bad || write_figures(dir, o, post, err, len);
     posteriors_free(post);
     free(post);
-    if (bad) return 1;
-    if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
-    if (o->granule && cal_figures_friction(dir, &o->config->granule, o->granule, err, len)) return 1;
-    for (int w = 0; w < o->n_walls; ++w)
-        if (cal_figures_friction(dir, &o->config->wall, o->walls[w], err, len)) return 1;
-    return 0;
+    return bad;
 }

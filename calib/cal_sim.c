@@ -34,7 +34,7 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     // A tier with a slice depth runs a periodic slice of the config's drum.
     exp_drum_physics p = {.diameter = c->diameter, .periodic = t->slice_depth > 0, .depth = c->depth,
                           .slice_depth = t->slice_depth, .fill = c->fill, .lambda = t->lambda,
-                          .gsd = {c->median_diameter, c->geometric_sd, c->truncation_sigmas},
+                          .gsd = c->gsd,
                           .density = c->density, .k_n = k_n, .xi = c->xi, .damping = config_damping(c),
                           .mu_s = gg_mu_s, .mu_r = gg_mu_r, .wall_mu_s = wall_mu_s, .wall_mu_r = wall_mu_r,
                           .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)c->seed};
@@ -71,7 +71,7 @@ exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, 
 {
     exp_cylinder_def d = exp_default_cylinder_def();
     d.lambda = t->cylinder_lambda, d.density = c->density, d.seed = seed;
-    d.gsd = (dem_gsd){c->median_diameter, c->geometric_sd, c->truncation_sigmas};
+    d.gsd = c->gsd;
     // Stage 1 comes before the friction is known: the pour uses the config's
     // stated prior friction (pour_mu_s, pour_mu_r). The stage reads how the
     // coordination number moves with k, not its level.
@@ -96,6 +96,15 @@ static void contact_text(char *out, size_t len, const dem_contact_params *p)
              p->mu_s, p->mu_r, (int)p->damping);
 }
 
+// A measured size table is named by its fingerprint, only when there is one,
+// so that every log-normal run keeps its key.
+static void gsd_table_text(const dem_gsd *g, char *out, size_t len)
+{
+    if (g->table.rows)
+        snprintf(out + strlen(out), len - strlen(out), " gsd_table=%d:%016llx", g->table.rows,
+                 (unsigned long long)dem_gsd_table_fingerprint(g));
+}
+
 static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
 {
     char gg[160], wall[160], plate[160];
@@ -110,6 +119,7 @@ static void drum_def_text(const exp_drum_def *d, char *out, size_t len)
     // Named only when not the pour, so that the stores of every pour run keep their keys.
     if (d->fill_method != EXP_FILL_POUR)
         snprintf(out + strlen(out), len - strlen(out), " fill_method=%s", exp_drum_fill_method_name(d->fill_method));
+    gsd_table_text(&d->gsd, out, len);
 }
 
 exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm)
@@ -149,6 +159,7 @@ void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
                        "wall[%s] seed=%llu",
              exp_results_version(), c->diameter, c->depth, c->lambda, c->density, c->gsd.median_diameter, c->gsd.geometric_sd,
              c->gsd.truncation_sigmas, gg, wall, (unsigned long long)c->seed);
+    gsd_table_text(&c->gsd, out, len);
 }
 
 void cal_bed_key(const cal_bed_case *b, char *out, size_t len)
@@ -532,7 +543,7 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     for (int c = 0; c < n_cases && !bad; ++c)
         for (int k = 0; k < n && !bad; ++k) {
             cal_drum_key(&cases[c], rpm[k], b.keys[c * n + k], sizeof b.keys[0]);
-            int got = cal_store_get(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
+            int got = cal_store_lookup(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
             bad = got < 0;
             if (got == 1) missing[n_missing++] = (drum_run){c, k};
             if (got == 0) count_stored(env, drum_kind(env), &out[c * n + k]);
@@ -607,7 +618,7 @@ int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record 
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
         cal_bed_key(&cases[k], keys[k], sizeof keys[k]);
-        int got = cal_store_get(env->store, keys[k], &out[k], err, len);
+        int got = cal_store_lookup(env->store, keys[k], &out[k], err, len);
         bad = got < 0;
         missing[k] = got == 1;
         if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k, missing[k] = 0;

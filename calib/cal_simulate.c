@@ -242,16 +242,20 @@ int cal_cmd_simulate(int argc, char **argv)
     char *sets[64];
     simulate_args a = {.sets = sets, .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
     int c;
-    while ((c = getopt_long(argc, argv, "o:s:h", opts, NULL)) != -1) {
+    optind = 1, opterr = 0;
+    while ((c = getopt_long(argc, argv, ":o:s:h", opts, NULL)) != -1) {
         if (c == 'h') return fputs(simulate_help, stdout), 0;
         if (c == 'o') a.out = optarg;
         else if (c == 's' && a.n_sets < 64) sets[a.n_sets++] = optarg;
         else if (c == 'r') a.rpm_list = optarg;
         else if (c == 'c') {
             if (cal_parse_checkpoint_every("simulate", optarg, &a.checkpoint_every_s)) return 2;
-        } else return fputs(simulate_help, stderr), 2;
+        } else if (c == 's') return fprintf(stderr, "granucal simulate: at most 64 --set options\n"), 2;
+        else return cal_option_error("simulate", c, argv);
     }
-    if (optind != argc - 1) return fputs(simulate_help, stderr), 2;
+    if (optind != argc - 1)
+        return fprintf(stderr, "granucal simulate: give one SCENE.yaml%s; see `granucal simulate --help`\n",
+                       optind < argc ? ", not several" : ""), 2;
     const char *path = argv[optind];
     for (size_t k = 0; k < sizeof simulate_runners / sizeof *simulate_runners; ++k)
         if (simulate_runners[k].claims(path)) return simulate_runners[k].run(path, &a);

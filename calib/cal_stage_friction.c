@@ -430,6 +430,8 @@ static int set_targets(search *s, const cal_series *angles, const cal_series *ar
     // granules pile steeper, Table B.1) is not corrected here by a number
     // measured at any known answer; the tier's table is the tier's.
     r->angle_target = pts[0]->value, r->angle_rpm = pts[0]->rpm;
+    r->angle_source = (cal_provenance){angles->synthetic, angles->synthetic_lambda};
+    r->csa_source = (cal_provenance){areas->synthetic, areas->synthetic_lambda};
     // The tier's spreads are one bed's; a candidate is the mean of its beds.
     double per_bed = 1 / sqrt(cal_tier_beds(s->t)), tier_angle_sd = s->t->angle_sd_deg * per_bed;
     r->angle_tolerance = sqrt(pts[0]->sd * pts[0]->sd + tier_angle_sd * tier_angle_sd);

@@ -87,6 +87,7 @@ typedef struct cal_friction_result {
     int n_rpm;
     double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
     double csa_tier_sd[CAL_MAX_RPM];    ///< the tier's measured seed spread at each speed (0: not measured)
+    cal_provenance angle_source, csa_source; ///< whether the data files' numbers are synthetic (the figures say so)
     int n;                              ///< candidates evaluated
     cal_candidate cand[CAL_MAX_EVALS];
     int best;                           ///< index of the chosen candidate, -1 if none usable

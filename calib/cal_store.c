@@ -30,7 +30,8 @@ static const cyaml_schema_field_t record_fields[] = {
     REC_FLOAT("dt_margin_min", dt_margin_min), CYAML_FIELD_INT("dt_lowered", CYAML_FLAG_OPTIONAL, cal_record, dt_lowered),
     CYAML_FIELD_BOOL("retry", CYAML_FLAG_OPTIONAL, cal_record, retry),
     CYAML_FIELD_STRING_PTR("writer", CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, cal_record, writer, 0, 256),
-    CYAML_FIELD_INT("granules", CYAML_FLAG_OPTIONAL, cal_record, granules), CYAML_FIELD_END};
+    // Required: the last line cal_store_put writes, so a record cut short at a line's end lacks it.
+    CYAML_FIELD_INT("granules", CYAML_FLAG_DEFAULT, cal_record, granules), CYAML_FIELD_END};
 static const cyaml_schema_value_t record_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cal_record, record_fields)};
 
 // This run, as written into every record: "host:pid".
@@ -59,16 +60,30 @@ void cal_store_path(const char *dir, const char *key, char *out, size_t len)
     snprintf(out, len, "%s/%s.yaml", dir, hash);
 }
 
-int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len)
+// 1 if the file's last byte is a line break, as every record cal_store_put
+// writes: one cut short within a line lacks it (even where the YAML parses).
+static int ends_with_newline(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    int last = EOF;
+    if (f && fseek(f, -1, SEEK_END) == 0) last = fgetc(f);
+    if (f) fclose(f);
+    return last == '\n';
+}
+
+enum { DAMAGED = -2 };
+
+// cal_store_get, with a damaged record (cut short, not YAML, a field
+// missing) told apart as DAMAGED from a record of another key (-1).
+static int load_record(const char *dir, const char *key, cal_record *out, char *err, size_t len)
 {
     char path[1200];
     cal_store_path(dir, key, path, sizeof path);
     memset(out, 0, sizeof *out);
     if (access(path, F_OK) != 0) return 1;
+    if (!ends_with_newline(path)) return exp_fail(err, len, "%s: cut short (no line break at its end)", path), DAMAGED;
     cal_record *r = NULL;
-    if (exp_yaml_load(path, &record_schema, (void **)&r, "a damaged store record: delete it to rerun that simulation",
-                      err, len))
-        return -1;
+    if (exp_yaml_load(path, &record_schema, (void **)&r, "a damaged store record", err, len)) return DAMAGED;
     if (strcmp(r->key, key) != 0) {
         exp_yaml_free(&record_schema, r);
         return exp_fail(err, len, "%s: holds a different simulation (hash collision); delete it", path), -1;
@@ -80,6 +95,31 @@ int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, 
         return 1;
     }
     return 0;
+}
+
+int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len)
+{
+    int got = load_record(dir, key, out, err, len);
+    return got == DAMAGED ? -1 : got;
+}
+
+int cal_store_lookup(const char *dir, const char *key, cal_record *out, char *err, size_t len)
+{
+    int got = load_record(dir, key, out, err, len);
+    if (got != DAMAGED) return got;
+    char why[1024], path[1200], aside[1300], hash[17];
+    snprintf(why, sizeof why, "%s", err);
+    why[strcspn(why, "\n")] = 0;
+    cal_store_path(dir, key, path, sizeof path);
+    cal_store_hash(key, hash);
+    snprintf(aside, sizeof aside, "%s/damaged", dir);
+    if (cal_mkdirs(aside, err, len)) return -1;
+    snprintf(aside, sizeof aside, "%s/damaged/%s.yaml", dir, hash);
+    // Another rank may have moved it first (ENOENT): absent to both, run once by the one it is dealt to.
+    if (rename(path, aside) != 0 && errno != ENOENT)
+        return exp_fail(err, len, "%s is damaged and cannot be moved aside to %s: %s", path, aside, strerror(errno)), -1;
+    fprintf(stderr, "granucal: damaged store record moved to %s (%s); its simulation runs again\n", aside, why);
+    return 1;
 }
 
 // YAML single-quoted scalar: quotes doubled, line breaks flattened.

@@ -40,9 +40,17 @@ void cal_store_hash(const char *key, char out[17]);
 void cal_store_path(const char *dir, const char *key, char *out, size_t len);
 
 /// Read the record of `key`: 0 found (fields filled, free with
-/// cal_record_free), 1 absent, -1 unreadable or a different key (message).
+/// cal_record_free), 1 absent, -1 unreadable, damaged or a different key
+/// (message). Never changes the store (a plan, a report, a verification).
 /// A retry record written by another run counts as absent.
 int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len);
+
+/// cal_store_get for a run that simulates what is missing: a damaged record
+/// (cut short, not YAML, a field missing) is moved to DIR/damaged/HASH.yaml
+/// (kept for inspection, never deleted; a later damaged copy replaces it),
+/// one line on stderr says so and that its simulation runs again, and it
+/// counts as absent (1). A record of another key stays an error (-1).
+int cal_store_lookup(const char *dir, const char *key, cal_record *out, char *err, size_t len);
 
 /// Write a record atomically. 0 on success.
 int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len);

@@ -14,6 +14,7 @@
 
 #include "cal_commands.h"
 #include "cal_mpi.h"
+#include "cal_plan.h"
 #include "cal_sim.h"
 #include "cal_util.h"
 #include "exp_common.h"
@@ -48,16 +49,23 @@ static const char help[] =
     "                       reported beside the ladder's own fidelity.md, not over it\n"
     "  --budget-hours H     replaces fidelity.budget_hours\n"
     "  --seeds N            replaces fidelity.seeds (1-16)\n"
-    "  --rungs A,B,...      only these rungs (default: every rung, in config order)\n"
+    "  --rungs A,B,...      only these rungs, in config order (a name not in the ladder\n"
+    "                       is refused); without it every rung, which needs --yes\n"
     "  --rpm A,B,...        only these of fidelity.rpm (e.g. --rpm 4 to narrow the\n"
     "                       4 rpm angle's error first; default: every speed)\n"
     "  --jobs N             simulations side by side (default: cores)\n"
     "  --checkpoint-every S wall seconds between a drum run's checkpoints (default 120;\n"
     "                       0: none); a killed study, run again, resumes each turn\n"
+    "  --plan               check the config, print the plan (each rung's drum runs,\n"
+    "                       core-hours and wall hours on --jobs workers, expected and\n"
+    "                       worst case, and which fit the budget) and stop: nothing runs\n"
+    "  --yes                run every rung: without --rungs the study prints its plan\n"
+    "                       and stops with exit status 2 (the whole ladder is many hours)\n"
     "  -h, --help           this text\n"
     "\n"
     "Outputs in DIR: fidelity.csv (rung x speed), fidelity_summary.csv (rung),\n"
-    "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png, store/.\n"
+    "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png (or, where every\n"
+    "rung run has one lambda, fidelity_vs_slice_depth.png), store/.\n"
     "Run it again with the same options: stored simulations are not rerun.\n";
 
 enum { MAX_RUNGS = 32, MAX_SPEEDS = 16, MAX_SEEDS = 16 };
@@ -72,6 +80,8 @@ typedef struct options {
     const char *report;                     ///< where the report goes (NULL: out)
     double budget_hours, checkpoint_every_s;
     int jobs, seeds; ///< seeds 0: the config's
+    int plan_only;   ///< --plan: print the plan and stop
+    int yes;         ///< --yes: the whole ladder (no --rungs) may run
 } options;
 
 typedef struct rung_result {
@@ -105,15 +115,18 @@ static int parse_options(int argc, char **argv, options *o)
                                           {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
                                           {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
                                           {"checkpoint-every", required_argument, 0, 'c'}, {"rpm", required_argument, 0, 'm'},
-                                          {"report", required_argument, 0, 'p'}, {0, 0, 0, 0}};
+                                          {"report", required_argument, 0, 'p'}, {"plan", no_argument, 0, 'P'},
+                                          {"yes", no_argument, 0, 'y'}, {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
-    optind = 1;
-    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+    optind = 1, opterr = 0;
+    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
         double v = NAN;
         switch (ch) {
         case 'o': o->out = optarg; break;
         case 'p': o->report = optarg; break;
+        case 'P': o->plan_only = 1; break;
+        case 'y': o->yes = 1; break;
         case 'r': o->rungs = optarg; break;
         case 'm': o->rpm = optarg; break;
         case 'b':
@@ -134,7 +147,7 @@ static int parse_options(int argc, char **argv, options *o)
             if (cal_parse_checkpoint_every("study", optarg, &o->checkpoint_every_s)) return 2;
             break;
         case 'h': fputs(help, stdout); return -1;
-        default: fputs(help, stderr); return 2;
+        default: return cal_option_error("study fidelity", ch, argv);
         }
     }
     if (optind < argc) o->config = argv[optind++];
@@ -149,6 +162,24 @@ static int wanted(const char *list, const char *name)
     size_t n = strlen(name);
     for (const char *p = list; (p = strstr(p, name)); p += n)
         if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == 0)) return 1;
+    return 0;
+}
+
+/// Every name of --rungs must be a rung of the ladder: a misspelt one would
+/// otherwise be skipped without a word. The error lists the rungs there are.
+static int check_rungs(const cal_fidelity *f, const char *list, const char *path, char *err, size_t len)
+{
+    char copy[1024];
+    snprintf(copy, sizeof copy, "%s", list);
+    for (char *save = NULL, *t = strtok_r(copy, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        unsigned k = 0;
+        while (k < f->rungs_count && strcmp(f->rungs[k].name, t) != 0) ++k;
+        if (k < f->rungs_count) continue;
+        char names[4096] = "";
+        for (unsigned j = 0; j < f->rungs_count; ++j)
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", j ? ", " : "", f->rungs[j].name);
+        return exp_fail(err, len, "--rungs %s: '%s' is not a rung of %s (fidelity.rungs); its rungs: %s", list, t, path, names);
+    }
     return 0;
 }
 
@@ -231,6 +262,45 @@ static void mean_sd(const double *x, int n, double *mean, double *sd)
     m = n ? m / n : NAN;
     for (int i = 0; i < n; ++i) v += (x[i] - m) * (x[i] - m);
     *mean = m, *sd = n > 1 ? sqrt(v / (n - 1)) : NAN;
+}
+
+// Each wanted rung's cost from the cost model (cal_plan.h): its seeds side by
+// side, each settling its own bed and turning every speed; and whether it
+// fits the budget left, in config order as run_ladder goes (which predicts
+// from the rungs it has measured by then, so the two can differ).
+static double print_plan(const study *s)
+{
+    const cal_fidelity *f = s->c->fidelity;
+    int parallel = s->opt.jobs * cal_mpi_size();
+    double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
+    cal_plan total = {{0}, {0}};
+    fprintf(stderr, "== plan: study fidelity, %d seed(s) x %u speed(s) a rung, %d worker(s); expected (worst case)\n", f->seeds,
+            f->rpm_count, parallel);
+    for (unsigned k = 0; k < f->rungs_count; ++k) {
+        const cal_rung *rung = &f->rungs[k];
+        if (!wanted(s->opt.rungs, rung->name)) continue;
+        cal_plan p = {{0}, {0}};
+        cal_tier t = tier_of(rung);
+        cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+        for (int w = 0; w < 2; ++w)
+            cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w);
+        int fits = spent + p.expected.wall_s <= budget_s;
+        spent += fits ? p.expected.wall_s : 0;
+        fprintf(stderr, "   %-22s %4d drum runs %8.2f (%8.2f) core-hours %7.2f (%7.2f) h%s\n", rung->name, p.expected.runs,
+                p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600, p.worst.wall_s / 3600,
+                fits ? "" : "  over the budget left: not run");
+        total.expected.runs += fits ? p.expected.runs : 0;
+        total.expected.core_s += fits ? p.expected.core_s : 0, total.expected.wall_s += fits ? p.expected.wall_s : 0;
+        total.worst.core_s += fits ? p.worst.core_s : 0, total.worst.wall_s += fits ? p.worst.wall_s : 0;
+    }
+    char e[128], w[128];
+    cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
+    fprintf(stderr, "== plan: the rungs within the budget (%.3g h): %d drum runs, expected %s; worst case %s\n"
+                    "   expected: each run ends at the steady test's first chance (two windows, then its averaging); worst "
+                    "case: max_time. At %.2g particle-steps per core-second (this project's 2-core machine); records "
+                    "already in the store are not subtracted.\n",
+            budget_s / 3600, total.expected.runs, e, w, CAL_PLAN_RATE);
+    return total.expected.wall_s;
 }
 
 // Run (or read back) every seed and speed of a rung and reduce them.
@@ -447,6 +517,27 @@ static void write_speeds_table(FILE *o, const study *s)
     }
 }
 
+// What the rungs run differ in, for the figure of the first speed: the scale
+// factor, or where every rung has one λ, the slice depth (a slice-depth study).
+static int against_depth(const study *s)
+{
+    double lambda = NAN, depth = NAN;
+    int depths_differ = 0;
+    for (int i = 0; i < s->n; ++i) {
+        const rung_result *r = &s->res[i];
+        if (!r->ran) continue;
+        if (isfinite(lambda) && r->rung->lambda != lambda) return 0;
+        depths_differ |= isfinite(depth) && r->depth != depth;
+        lambda = r->rung->lambda, depth = r->depth;
+    }
+    return depths_differ;
+}
+
+static const char *versus_file(const study *s)
+{
+    return against_depth(s) ? "fidelity_vs_slice_depth.png" : "fidelity_vs_lambda.png";
+}
+
 static int write_markdown(const study *s, const char *command, double wall, char *err, size_t len)
 {
     const cal_fidelity *f = s->c->fidelity;
@@ -503,8 +594,8 @@ static int write_markdown(const study *s, const char *command, double wall, char
             fprintf(o, "| %g (%s, %g rpm) | %.2f | %.2f |\n", s->res[i].rung->lambda, s->res[i].rung->name, f->rpm[0],
                     s->res[i].angle[0], s->res[i].csa[0]);
     fprintf(o, "\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
-               "`fidelity_vs_lambda.png`%s.\n",
-            f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
+               "`%s`%s.\n",
+            versus_file(s), f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
     return cal_atomic_commit(&a, err, len);
 }
 
@@ -514,7 +605,8 @@ typedef struct rung_points {
     double cost[MAX_RUNGS], angle_error[MAX_RUNGS], csa_error[MAX_RUNGS]; ///< all but the finest
     const char *name[MAX_RUNGS];
     int m;
-    double lambda[MAX_RUNGS], angle[MAX_RUNGS], angle_sd[MAX_RUNGS], csa[MAX_RUNGS], csa_sd[MAX_RUNGS];
+    double lambda[MAX_RUNGS], depth_mm[MAX_RUNGS], angle[MAX_RUNGS], angle_sd[MAX_RUNGS], csa[MAX_RUNGS],
+        csa_sd[MAX_RUNGS];
     const char *rung_of[MAX_RUNGS];
 } rung_points;
 
@@ -524,7 +616,8 @@ static void collect_rungs(const study *s, rung_points *p)
     for (int i = 0; i < s->n; ++i) {
         const rung_result *r = &s->res[i];
         if (!r->ran) continue;
-        p->lambda[p->m] = r->rung->lambda, p->angle[p->m] = r->angle[0], p->csa[p->m] = r->csa[0];
+        p->lambda[p->m] = r->rung->lambda, p->depth_mm[p->m] = 1e3 * r->depth;
+        p->angle[p->m] = r->angle[0], p->csa[p->m] = r->csa[0];
         p->angle_sd[p->m] = isfinite(r->angle_sd[0]) ? r->angle_sd[0] : 0;
         p->csa_sd[p->m] = isfinite(r->csa_sd[0]) ? r->csa_sd[0] : 0;
         p->rung_of[p->m++] = r->rung->name;
@@ -553,29 +646,36 @@ static int plot_error_vs_cost(const study *s, const rung_points *p, char *err, s
     return exp_plot_png(path, &axes, 2, v, 1000, 640, err, len);
 }
 
-// The first speed's angle and CSA against λ, beside the paper's Table B.1.
+// The first speed's angle and CSA against λ, or against the slice depth where
+// every rung has one λ; beside the paper's Table B.1 (λ 8, 27, 64, its drum at
+// 4 rpm) on a λ axis at 4 rpm only.
 static int plot_vs_lambda(const study *s, const rung_points *p, char *err, size_t len)
 {
-    double b1_l[3], b1_a[3], b1_c[3];
+    double b1_l[3], b1_a[3], b1_c[3], rpm = s->c->fidelity->rpm[0];
     for (int k = 0; k < 3; ++k)
         b1_l[k] = table_b1[k].lambda, b1_a[k] = table_b1[k].angle_deg, b1_c[k] = table_b1[k].csa_percent;
+    int depth = against_depth(s), with_b1 = !depth && rpm == 4;
     size_t m = (size_t)p->m;
+    const double *x = depth ? p->depth_mm : p->lambda;
     exp_plot_series v[4] = {
-        {.n = m, .x = p->lambda, .y = p->angle, .err = p->angle_sd, .names = p->rung_of,
+        {.n = m, .x = x, .y = p->angle, .err = p->angle_sd, .names = p->rung_of,
          .label = "angle, granucal (bars: seed sd)",
          .rgb = {0.84, 0.15, 0.16}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_CIRCLE},
-        {.n = m, .x = p->lambda, .y = p->csa, .err = p->csa_sd, .label = "CSA, granucal (bars: seed sd)",
+        {.n = m, .x = x, .y = p->csa, .err = p->csa_sd, .label = "CSA, granucal (bars: seed sd)",
          .rgb = {0.12, 0.40, 0.75}, .style = EXP_PLOT_POINTS, .marker = EXP_MARK_SQUARE},
-        {.n = 3, .x = b1_l, .y = b1_a, .label = "angle, paper's Table B.1", .rgb = {0.95, 0.6, 0.5},
+        {.n = 3, .x = b1_l, .y = b1_a, .label = "angle, paper's Table B.1 (4 rpm)", .rgb = {0.95, 0.6, 0.5},
          .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_TRIANGLE, .dashed = 1},
-        {.n = 3, .x = b1_l, .y = b1_c, .label = "CSA, paper's Table B.1", .rgb = {0.5, 0.65, 0.95},
+        {.n = 3, .x = b1_l, .y = b1_c, .label = "CSA, paper's Table B.1 (4 rpm)", .rgb = {0.5, 0.65, 0.95},
          .style = EXP_PLOT_LINE_POINTS, .marker = EXP_MARK_DIAMOND, .dashed = 1},
     };
     char path[1200], title[160];
-    snprintf(path, sizeof path, "%s/fidelity_vs_lambda.png", s->report);
-    snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", s->c->fidelity->rpm[0]);
-    exp_plot_axes axes = {.title = title, .xlabel = "scale factor λ", .ylabel = "angle (°) / CSA (%)", .log_x = 1};
-    return exp_plot_png(path, &axes, 4, v, 1000, 640, err, len);
+    snprintf(path, sizeof path, "%s/%s", s->report, versus_file(s));
+    if (depth)
+        snprintf(title, sizeof title, "Angle and CSA against the slice depth (λ %g, %g rpm)", p->lambda[0], rpm);
+    else snprintf(title, sizeof title, "Angle and CSA against the scale factor λ (%g rpm)", rpm);
+    exp_plot_axes axes = {.title = title, .xlabel = depth ? "slice depth (mm; the drum's depth for a full drum)" : "scale factor λ",
+                          .ylabel = "angle (°) / CSA (%)", .log_x = !depth};
+    return exp_plot_png(path, &axes, with_b1 ? 4 : 2, v, 1000, 640, err, len);
 }
 
 // Each rung's angle and CSA against the drum's speed (a study of several
@@ -658,7 +758,7 @@ int cal_cmd_study(int argc, char **argv)
 {
     if (argc < 2 || strcmp(argv[1], "fidelity") != 0) {
         if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) return fputs(help, stdout), 0;
-        fprintf(stderr, "granucal study: the study to run is `fidelity`\n\n%s", help);
+        fprintf(stderr, "granucal study: the study to run is `fidelity`; see `granucal study --help`\n");
         return 2;
     }
     study *s = calloc(1, sizeof *s);
@@ -676,7 +776,19 @@ int cal_cmd_study(int argc, char **argv)
     if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
     else if (!s->c) status = 1;
     if (!status && s->opt.seeds) s->c->fidelity->seeds = s->opt.seeds;
+    if (!status && s->opt.rungs) status = check_rungs(s->c->fidelity, s->opt.rungs, s->c->path, s->err, sizeof s->err);
     if (!status && s->opt.rpm) status = narrow_speeds(s->c->fidelity, s->opt.rpm, s->c->path, s->err, sizeof s->err);
+    if (!status && (s->opt.plan_only || (!s->opt.rungs && !s->opt.yes))) {
+        print_plan(s);
+        if (s->opt.plan_only) fputs("granucal study: --plan: the config checked, nothing was run\n", stderr);
+        else
+            status = 2, fputs("granucal study: no --rungs: the plan above is the whole ladder; run it with --yes, or choose "
+                              "rungs with --rungs A,B (nothing was run)\n", stderr);
+        if (s->c) cal_config_free(s->c);
+        free(s);
+        cal_mpi_finalize();
+        return status;
+    }
     if (!status) {
         snprintf(s->out, sizeof s->out, "%s", s->opt.out);
         snprintf(s->report, sizeof s->report, "%s", s->opt.report ? s->opt.report : s->opt.out);

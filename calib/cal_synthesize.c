@@ -19,6 +19,7 @@
 #include "cal_commands.h"
 #include "cal_data.h"
 #include "cal_mpi.h"
+#include "cal_plan.h"
 #include "cal_sim.h"
 #include "cal_stages.h"
 #include "cal_store.h"
@@ -58,6 +59,9 @@ static const char help[] =
     "                        (drum, pairs, seed, speed, tier, results version) is\n"
     "                        copied into DIR/store byte for byte, not run again\n"
     "  --jobs N              simulations side by side (default: cores)\n"
+    "  --plan                check every input, print the plan (drum runs, core-hours and\n"
+    "                        wall hours on --jobs workers, expected and worst case) and\n"
+    "                        stop: nothing runs, no folder is made\n"
     "  -h, --help            this text\n"
     "\n"
     "Each value is the mean over the seeds whose run is usable; its spread column is the\n"
@@ -72,6 +76,7 @@ typedef struct options {
     const char *config, *tier, *out, *reuse;
     pair granule, walls[MAX_WALLS];
     int n_walls, has_granule, jobs, n_seeds;
+    int plan_only; ///< --plan: print the plan and stop
     double k_n; ///< NAN: the config's
     long seeds[MAX_SEEDS];
 } options;
@@ -110,16 +115,17 @@ static int parse_options(int argc, char **argv, options *o)
     static const struct option longs[] = {{"tier", 1, 0, 't'},  {"granule", 1, 0, 'g'}, {"wall", 1, 0, 'w'},
                                           {"k-n", 1, 0, 'k'},   {"seeds", 1, 0, 's'},   {"out", 1, 0, 'o'},
                                           {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},    {"reuse", 1, 0, 'r'},
-                                          {0, 0, 0, 0}};
+                                          {"plan", 0, 0, 'p'},    {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .k_n = NAN, .n_seeds = 3, .seeds = {101, 102, 103},
                    .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
-    optind = 1;
-    for (int ch; (ch = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
+    optind = 1, opterr = 0;
+    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
         double v;
         switch (ch) {
         case 't': o->tier = optarg; break;
         case 'o': o->out = optarg; break;
         case 'r': o->reuse = optarg; break;
+        case 'p': o->plan_only = 1; break;
         case 'g':
             if (parse_pair(optarg, &o->granule.mu_s, &o->granule.mu_r))
                 return bad_option("--granule", optarg, "need MU_S,MU_R, both > 0");
@@ -146,7 +152,7 @@ static int parse_options(int argc, char **argv, options *o)
             o->jobs = (int)v;
             break;
         case 'h': fputs(help, stdout); return -1;
-        default: fputs(help, stderr); return 2;
+        default: return cal_option_error("synthesize", ch, argv);
         }
     }
     if (optind < argc) o->config = argv[optind++];
@@ -347,6 +353,35 @@ static int write_files(job *j, const lining_result *res, const char *command)
     return write_series(j, res, command, 1) || write_series(j, res, command, 0);
 }
 
+// What making the data costs: each lining's seeds side by side, each seed
+// settling its own bed and turning the speeds (cal_plan.h; records already in
+// the store or --reuse are not subtracted).
+static void print_plan(const job *j)
+{
+    int parallel = j->opt.jobs * cal_mpi_size();
+    cal_plan total = {{0}, {0}};
+    fprintf(stderr, "== plan: synthesize at tier '%s', %d worker(s); expected (worst case)\n", j->t->name, parallel);
+    for (int l = 0; l < j->n_linings; ++l) {
+        cal_plan p = {{0}, {0}};
+        cal_drum_case d = case_of(j, &j->linings[l], j->opt.seeds[0]);
+        for (int w = 0; w < 2; ++w)
+            cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, j->rpm, j->n_rpm, j->opt.n_seeds, 1, 0, 0, parallel, w);
+        fprintf(stderr, "   %-20s %4d drum runs %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", j->linings[l].surface,
+                p.expected.runs, p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600,
+                p.worst.wall_s / 3600);
+        total.expected.runs += p.expected.runs, total.expected.core_s += p.expected.core_s;
+        total.expected.wall_s += p.expected.wall_s, total.worst.core_s += p.worst.core_s, total.worst.wall_s += p.worst.wall_s;
+        total.expected.memory_mb = fmax(total.expected.memory_mb, p.expected.memory_mb);
+    }
+    char e[128], w[128];
+    cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
+    fprintf(stderr, "== plan: %d drum runs (%d lining(s) x %d seed(s) x %d speed(s)); expected %s; worst case %s; %.0f MB a "
+                    "simulation\n   expected: each run ends at the steady test's first chance (two windows, then its "
+                    "averaging); worst case: max_time. k_n %g N/m. At %.2g particle-steps per core-second (this project's "
+                    "2-core machine); records already in the store or --reuse are not subtracted.\n",
+            total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb, j->k_n, CAL_PLAN_RATE);
+}
+
 static int prepare(job *j)
 {
     j->c = cal_config_load(j->opt.config, j->opt.tier, j->err, sizeof j->err);
@@ -360,6 +395,8 @@ static int prepare(job *j)
     else snprintf(j->out, sizeof j->out, "results/synthetic-%.60s", j->t->name);
     if (j->opt.reuse && access(j->opt.reuse, R_OK | X_OK) != 0)
         return exp_fail(j->err, sizeof j->err, "--reuse %s: %s", j->opt.reuse, strerror(errno));
+    print_plan(j);
+    if (j->opt.plan_only) return 0; // no folder made
     if (cal_prepare_output(j->out, j->err, sizeof j->err)) return 1;
     snprintf(j->env.store, sizeof j->env.store, "%s/store", j->out);
     j->env.workers = j->opt.jobs, j->env.use_fork = cal_mpi_size() == 1, j->env.tty = isatty(2);
@@ -391,12 +428,15 @@ int cal_cmd_synthesize(int argc, char **argv)
 #endif
     lining_result res[MAX_WALLS + 1];
     status = prepare(j);
-    if (!status) plan_progress(j);
+    if (!status && j->opt.plan_only) {
+        fputs("granucal synthesize: --plan: every input checked, nothing was run\n", stderr);
+        j->n_linings = 0; // nothing to make, nothing to write
+    } else if (!status) plan_progress(j);
     for (int l = 0; l < j->n_linings && !status; ++l) {
         fprintf(stderr, "== %s: %d seed(s) x %d speed(s)\n", j->linings[l].surface, j->opt.n_seeds, j->n_rpm);
         status = make_lining(j, &j->linings[l], &res[l]);
     }
-    if (!status && cal_mpi_rank() == 0) {
+    if (!status && !j->opt.plan_only && cal_mpi_rank() == 0) {
         status = write_files(j, res, command);
         if (!status) fprintf(stderr, "granucal synthesize: wrote %s/repose_angle.csv and occupied_area.csv\n", j->out);
     }

@@ -65,5 +65,8 @@ dem_gsd dem_scale_gsd(const dem_gsd *g, double lambda)
     // Eq. 15 scales every diameter by the same factor: ln d shifts by
     // ln(λ)/3, so σ_g and the truncation (in σ) are unchanged.
     s.median_diameter = dem_scale_radius(g->median_diameter, lambda);
+    // A measured table: each row's diameter by the same factor; the
+    // cumulative fractions (numbers of granules) are unchanged.
+    for (int i = 0; i < g->table.rows; i++) s.table.diameter[i] = dem_scale_radius(g->table.diameter[i], lambda);
     return s;
 }

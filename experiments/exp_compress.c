@@ -431,7 +431,7 @@ static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t
 {
     *d = exp_default_compress_def();
     d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
-    d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
     dem_damping_mode mode;
     if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
     d->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, 0, mode); // no rolling here (μ_r = 0 switches it off)

@@ -69,7 +69,7 @@ static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t
 {
     *d = exp_default_cylinder_def();
     d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
-    d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
     dem_damping_mode mode;
     if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
     // The container's friction is the granules' (as in the calibration's

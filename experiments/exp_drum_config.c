@@ -7,7 +7,9 @@
 
 #include "exp_common.h"
 #include "exp_contact_rules.h"
+#include "exp_gsd_table.h"
 #include <errno.h>
+#include <libgen.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <math.h>
@@ -29,8 +31,10 @@ static const cyaml_schema_field_t drum_fields[] = {
     CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, exp_drum_yaml, experiment, 1, 16),
     REQ_FLOAT("diameter", diameter), REQ_FLOAT("depth", depth), REQ_FLOAT("fill", fill),
     CYAML_FIELD_BOOL("periodic", CYAML_FLAG_DEFAULT, exp_drum_yaml, periodic), OPT_FLOAT("slice_depth", slice_depth),
-    REQ_FLOAT("density", density), REQ_FLOAT("median_diameter", median_diameter),
-    REQ_FLOAT("geometric_sd", geometric_sd), REQ_FLOAT("truncation_sigmas", truncation_sigmas),
+    REQ_FLOAT("density", density), OPT_FLOAT("median_diameter", median_diameter),
+    OPT_FLOAT("geometric_sd", geometric_sd), OPT_FLOAT("truncation_sigmas", truncation_sigmas),
+    CYAML_FIELD_STRING_PTR("gsd_table", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, gsd_table, 1, 1000),
+    CYAML_FIELD_STRING_PTR("gsd_basis", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, gsd_basis, 1, 16),
     REQ_FLOAT("lambda", lambda), REQ_FLOAT("k_n", k_n), REQ_FLOAT("xi", xi), REQ_FLOAT("mu_s", mu_s),
     REQ_FLOAT("mu_r", mu_r),
     CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, exp_drum_yaml, damping, 1, 32),
@@ -117,7 +121,7 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     *run = exp_default_drum_run_opts();
     exp_drum_physics p = {.diameter = y->diameter, .periodic = y->periodic, .depth = y->depth,
                           .slice_depth = y->slice_depth, .fill = y->fill, .lambda = y->lambda,
-                          .gsd = {y->median_diameter, y->geometric_sd, y->truncation_sigmas},
+                          .gsd = y->gsd,
                           .density = y->density, .k_n = y->k_n, .xi = y->xi, .mu_s = y->mu_s, .mu_r = y->mu_r,
                           .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)y->seed};
     if (exp_damping_from_name(y->damping, "damping", &p.damping, err, len)) return 1;
@@ -125,7 +129,13 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     p.wall_mu_s = y->mu_s, p.wall_mu_r = y->mu_r;
     if (strcmp(y->wall, "granules") != 0) {
         const exp_material_yaml *m = find_material(y, y->wall);
-        if (!m) return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials", y->wall);
+        if (!m) { // the linings this file defines, so the user can pick one
+            char names[512] = "granules";
+            for (unsigned k = 0; k < y->materials_count; ++k)
+                snprintf(names + strlen(names), sizeof names - strlen(names), ", %s", y->materials[k].name);
+            return exp_fail(err, len, "wall = '%s': not 'granules' nor a name under materials; the walls are: %s", y->wall,
+                            names);
+        }
         p.wall_mu_s = m->mu_s, p.wall_mu_r = m->mu_r;
     }
     if (y->fill_method && exp_drum_fill_method_from_name(y->fill_method, &p.fill_method))
@@ -140,7 +150,34 @@ int exp_drum_config_defs(const exp_drum_yaml *y, exp_drum_def *def, exp_drum_run
     return 0;
 }
 
-static int validate(const source *from, const exp_drum_yaml *y, char *err, size_t len)
+// The size distribution into y->gsd: the log-normal's three keys, or a
+// measured table (gsd_table, relative to the config file, on gsd_basis), not both.
+static int load_gsd(const source *from, exp_drum_yaml *y, char *err, size_t len)
+{
+    if (!y->gsd_table) {
+        if (y->gsd_basis) return located(from, "gsd_basis", err, len, "given without gsd_table");
+        y->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
+        return 0; // its values are checked with the drum (exp_drum_check)
+    }
+    const struct { const char *key; double v; } lognormal[] = {
+        {"median_diameter", y->median_diameter}, {"geometric_sd", y->geometric_sd},
+        {"truncation_sigmas", y->truncation_sigmas}};
+    for (size_t k = 0; k < sizeof lognormal / sizeof *lognormal; ++k)
+        if (lognormal[k].v != 0)
+            return located(from, lognormal[k].key, err, len,
+                           "gsd_table gives the size distribution: remove the log-normal's keys (give one or the other)");
+    dem_gsd_basis basis;
+    if (exp_gsd_basis_from_name(y->gsd_basis, &basis))
+        return located(from, "gsd_basis", err, len, "'%s': say what the table's percentages count: volume (laser "
+                       "diffraction, sieving) or number", y->gsd_basis ? y->gsd_basis : "absent");
+    char dir[1024], path[2048];
+    snprintf(dir, sizeof dir, "%s", from->path);
+    if (y->gsd_table[0] == '/') snprintf(path, sizeof path, "%s", y->gsd_table);
+    else snprintf(path, sizeof path, "%s/%s", dirname(dir), y->gsd_table);
+    return exp_gsd_table_load(path, y->gsd_basis, &y->gsd, err, len);
+}
+
+static int validate(const source *from, exp_drum_yaml *y, char *err, size_t len)
 {
     if (strcmp(y->experiment, "drum") != 0) return located(from, "experiment", err, len, "must be drum");
     // libcyaml reads inf and nan as numbers; the range checks below let inf through.
@@ -153,6 +190,7 @@ static int validate(const source *from, const exp_drum_yaml *y, char *err, size_
     for (size_t k = 0; k < sizeof numbers / sizeof *numbers; ++k)
         if (!isfinite(numbers[k].v))
             return located(from, numbers[k].key, err, len, "%g must be a finite number", numbers[k].v);
+    if (load_gsd(from, y, err, len)) return 1;
     if (y->start_tilt_deg && !(*y->start_tilt_deg >= 0 && *y->start_tilt_deg <= 90))
         return located(from, "start_tilt_deg", err, len, "%g must be in [0, 90] degrees", *y->start_tilt_deg);
     if (y->window < 0) return located(from, "window", err, len, "%g must be >= 0 (0 or absent: 1 s)", y->window);

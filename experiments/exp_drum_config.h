@@ -20,7 +20,9 @@ typedef struct exp_drum_yaml {
     double diameter, depth, fill;
     int periodic;         ///< a periodic slice of depth `slice_depth`
     double slice_depth;
-    double density, median_diameter, geometric_sd, truncation_sigmas;
+    double density, median_diameter, geometric_sd, truncation_sigmas; ///< the log-normal (absent with gsd_table)
+    char *gsd_table;      ///< optional: a measured size table (exp_gsd_table.h), relative to the config file
+    char *gsd_basis;      ///< with gsd_table: "volume" or "number"
     double lambda;
     double k_n;           ///< real granule stiffness, k_n = k_s = k_r (section 3.2)
     double xi, mu_s, mu_r;
@@ -34,6 +36,7 @@ typedef struct exp_drum_yaml {
     double *start_tilt_deg; ///< optional (NULL: exp_default_drum_run_opts' 20°)
     int closing_px;
     int seed;
+    dem_gsd gsd;          ///< derived on load: the size distribution (the log-normal's keys or the table)
 } exp_drum_yaml;
 
 /// 1 if the file is a drum experiment (its first key is `experiment: drum`).

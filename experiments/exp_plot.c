@@ -188,7 +188,8 @@ static page page_size(void)
 
 // Width in mm of the widest of n strings (NULL ones skipped) at a character
 // height of char_mm. PLplot 5.15 exports no string measure, so this counts
-// code points at DejaVu Sans' mean advance (about 0.6 of the height).
+// code points at DejaVu Sans' mean advance as cairo draws PLplot's character
+// (0.72 of its height: 17 characters of a rung's name measured 155 px at 14 px).
 static double widest_text(size_t n, const char *const *text, double char_mm)
 {
     size_t widest = 0;
@@ -197,14 +198,29 @@ static double widest_text(size_t n, const char *const *text, double char_mm)
         for (const unsigned char *c = (const unsigned char *)text[k]; c && *c; ++c) points += (*c & 0xC0) != 0x80;
         if (points > widest) widest = points;
     }
-    return 0.6 * char_mm * (double)widest;
+    return 0.72 * char_mm * (double)widest;
+}
+
+// Characters of the widest y tick label granucal wrote itself in the last
+// frame (a narrow log axis: label_narrow_log_axis), 0 where PLplot wrote them.
+static int own_y_label_chars;
+
+// Where the y label goes (in character heights from the axis): clear of the
+// widest tick label of the last frame (PLplot's: plgyax gives its characters;
+// a digit is about 0.85 of the character height wide at this font).
+static double ylabel_offset(void)
+{
+    PLINT digmax = 0, digits = 0;
+    plgyax(&digmax, &digits);
+    int chars = digits > own_y_label_chars ? digits : own_y_label_chars;
+    return fmin(7.0, fmax(5.0, 0.7 + 0.85 * chars + 0.9));
 }
 
 static void title_and_labels(const char *title, const char *xlabel, const char *ylabel)
 {
     plcol0(INK);
     if (xlabel) plmtex("b", 3.2, 0.5, 0.5, xlabel);
-    if (ylabel) plmtex("l", 5.0, 0.5, 0.5, ylabel);
+    if (ylabel) plmtex("l", ylabel_offset(), 0.5, 0.5, ylabel);
     if (title) {
         text_size(TITLE);
         plmtex("t", 1.2, 0.5, 0.5, title);
@@ -233,6 +249,7 @@ static void label_narrow_log_axis(int y_axis, double lo, double hi)
             double at = log10(m) + e;
             if (at < lo - 1e-9 || at > hi + 1e-9) continue;
             snprintf(text, sizeof text, "%g", m * pow(10, e));
+            if (y_axis && (int)strlen(text) > own_y_label_chars) own_y_label_chars = (int)strlen(text);
             if (y_axis) plmtex("lv", 0.7, (at - lo) / (hi - lo), 1.0, text);
             else plmtex("b", 1.6, (at - lo) / (hi - lo), 0.5, text);
         }
@@ -244,12 +261,14 @@ static void frame(int log_x, int log_y, double x0, double x1, double y0, double 
 {
     char xopt[16], yopt[16];
     int narrow_x = log_x && x1 - x0 < NARROW_DECADES, narrow_y = log_y && y1 - y0 < NARROW_DECADES;
-    int fixed_x = log_x && x0 >= -3 && x1 <= 5, fixed_y = log_y && y0 >= -3 && y1 <= 5;
+    // (a map's axes reach a little past its decades: the half decade allowed)
+    int fixed_x = log_x && x0 >= -3.5 && x1 <= 5.5, fixed_y = log_y && y0 >= -3.5 && y1 <= 5.5;
     plcol0(INK);
     plwidth(1);
     snprintf(xopt, sizeof xopt, "bcst%s%s%s", narrow_x ? "" : "n", log_x ? "l" : "", fixed_x ? "f" : "");
     snprintf(yopt, sizeof yopt, "bcstv%s%s%s", narrow_y ? "" : "n", log_y ? "l" : "", fixed_y ? "f" : "");
     plbox(xopt, 0, 0, yopt, 0, 0);
+    own_y_label_chars = 0;
     if (narrow_x) label_narrow_log_axis(0, x0, x1);
     if (narrow_y) label_narrow_log_axis(1, y0, y1);
 }
@@ -266,9 +285,24 @@ static const char *glyph(exp_plot_marker m)
     case EXP_MARK_STAR: return "★";
     case EXP_MARK_CROSS: return "✕";
     case EXP_MARK_OPEN_CIRCLE: return "○";
+    case EXP_MARK_OPEN_SQUARE: return "□";
+    case EXP_MARK_OPEN_DIAMOND: return "◇";
     case EXP_MARK_CIRCLE: break;
     }
     return "●";
+}
+
+// An open marker's filled twin, drawn white under it on a map so that it
+// reads on the map's colours (NULL for the others). On a chart open markers
+// are hollow: what lies under them shows through.
+static const char *white_inside(exp_plot_marker m)
+{
+    switch (m) {
+    case EXP_MARK_OPEN_CIRCLE: return glyph(EXP_MARK_CIRCLE);
+    case EXP_MARK_OPEN_SQUARE: return glyph(EXP_MARK_SQUARE);
+    case EXP_MARK_OPEN_DIAMOND: return glyph(EXP_MARK_DIAMOND);
+    default: return NULL;
+    }
 }
 
 static double marker_scale(exp_plot_marker m)
@@ -276,9 +310,28 @@ static double marker_scale(exp_plot_marker m)
     return m == EXP_MARK_STAR ? 1.9 : 1.0;
 }
 
-static void mark(double x, double y, exp_plot_marker m)
+// Half the size of a marker drawn at a character height of char_mm (the
+// glyphs fill about 0.9 of the character's height).
+static double marker_half_mm(exp_plot_marker m, double char_mm)
+{
+    return 0.45 * char_mm * marker_scale(m);
+}
+
+static void mark(double x, double y, exp_plot_marker m, int colour)
 {
     text_size(marker_scale(m));
+    plcol0(colour);
+    plstring(1, &x, &y, glyph(m));
+    text_size(TEXT);
+}
+
+// A map's marker: an open one white inside.
+static void map_mark(double x, double y, exp_plot_marker m, int colour)
+{
+    text_size(marker_scale(m));
+    const char *under = white_inside(m);
+    if (under) plcol0(WHITE), plstring(1, &x, &y, under);
+    plcol0(colour);
     plstring(1, &x, &y, glyph(m));
     text_size(TEXT);
 }
@@ -378,25 +431,16 @@ static void draw_error_bars(const exp_plot_series *s, int log_x, int log_y, doub
     }
 }
 
-static void draw_markers_and_names(const exp_plot_series *s, int log_x, int log_y, range xr, double shift)
+static void draw_markers(const exp_plot_series *s, int colour, int log_x, int log_y, double shift)
 {
     for (size_t i = 0; i < s->n; ++i) {
         double x = world(s->x[i], log_x) + shift, y = world(s->y[i], log_y);
-        if (!isfinite(x) || !isfinite(y)) continue;
-        if (s->style != EXP_PLOT_LINE) mark(x, y, s->marker);
-        if (s->names && s->names[i]) {
-            // beside the point, on the side with room for it (text past the axes is clipped),
-            // and on the other side from an earlier named point at the same x (two rungs of one λ)
-            int left = x - xr.lo > 0.7 * (xr.hi - xr.lo);
-            for (size_t j = 0; j < i; ++j)
-                if (s->names[j] && fabs(world(s->x[j], log_x) + shift - x) < 0.01 * (xr.hi - xr.lo)) left = !left;
-            text_size(SMALL);
-            plptex(x + (left ? -0.015 : 0.015) * (xr.hi - xr.lo), y, 1, 0, left ? 1.0 : 0.0, s->names[i]);
-            text_size(TEXT);
-        }
+        if (isfinite(x) && isfinite(y)) mark(x, y, s->marker, colour);
     }
 }
 
+// Line, then markers, then the error bars over them: a bar shorter than its
+// marker still shows on an open one.
 static void draw_series(const exp_plot_series *s, int colour, int log_x, int log_y, range xr)
 {
     double shift = s->dodge * (xr.hi - xr.lo);
@@ -408,9 +452,166 @@ static void draw_series(const exp_plot_series *s, int colour, int log_x, int log
         if (isfinite(y)) pljoin(xr.lo, y, xr.hi, y);
     } else if (s->style != EXP_PLOT_POINTS) draw_polyline(s, log_x, log_y, shift);
     pllsty(1);
+    if (s->style != EXP_PLOT_HLINE && s->style != EXP_PLOT_LINE) draw_markers(s, colour, log_x, log_y, shift);
+    plcol0(colour);
     draw_error_bars(s, log_x, log_y, shift);
-    if (s->style != EXP_PLOT_HLINE) draw_markers_and_names(s, log_x, log_y, xr, shift);
     plwidth(1);
+}
+
+// ---- names beside points ------------------------------------------------------------
+
+static int boxes_overlap(const exp_plot_box *a, const exp_plot_box *b)
+{
+    return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
+}
+
+static int box_is_free(const exp_plot_box *b, double width, double height, size_t n_obstacles,
+                       const exp_plot_box *obstacles, size_t n_placed, const exp_plot_box *placed)
+{
+    if (b->x0 < 0 || b->y0 < 0 || b->x1 > width || b->y1 > height) return 0;
+    for (size_t k = 0; k < n_obstacles; ++k)
+        if (boxes_overlap(b, &obstacles[k])) return 0;
+    for (size_t k = 0; k < n_placed; ++k)
+        if (boxes_overlap(b, &placed[k])) return 0;
+    return 1;
+}
+
+// The label's box on one side of its point (right: side 0, left: 1), its row
+// `row` rows of `pitch` above (row > 0) or below the point's.
+static exp_plot_box label_box(double px, double py, double w, double h, double reach, int side, double row_y)
+{
+    double x0 = side == 0 ? px + reach : px - reach - w;
+    return (exp_plot_box){x0, py + row_y - h / 2, x0 + w, py + row_y + h / 2};
+}
+
+size_t exp_plot_place_labels(size_t n, const double *px, const double *py, const double *w, double h, double mark,
+                             double gap, size_t n_obstacles, const exp_plot_box *obstacles, double width,
+                             double height, exp_plot_box *out)
+{
+    size_t unplaced = 0, rows = (size_t)ceil(height / (h + 0.5 * gap)) + 1;
+    for (size_t k = 0; k < n; ++k) {
+        int found = 0;
+        for (size_t r = 0; r <= rows && !found; ++r)
+            for (int dir = 0; dir < (r ? 2 : 1) && !found; ++dir) // the point's row, then above, then below
+                for (int side = 0; side < 2 && !found; ++side) {
+                    double row_y = (double)r * (h + 0.5 * gap) * (dir ? -1 : 1);
+                    out[k] = label_box(px[k], py[k], w[k], h, mark + gap, side, row_y);
+                    found = box_is_free(&out[k], width, height, n_obstacles, obstacles, k, out);
+                }
+        if (!found) out[k] = label_box(px[k], py[k], w[k], h, mark + gap, 0, 0), unplaced++;
+    }
+    return unplaced;
+}
+
+// The viewport's place on the page and the world rectangle it shows: mm <-> world.
+typedef struct plot_area {
+    double x0, y0, width, height; ///< mm on the page
+    range xr, yr;                 ///< world coordinates
+} plot_area;
+
+static plot_area current_area(page p, range xr, range yr)
+{
+    PLFLT x0, x1, y0, y1;
+    plgvpd(&x0, &x1, &y0, &y1);
+    return (plot_area){x0 * p.width, y0 * p.height, (x1 - x0) * p.width, (y1 - y0) * p.height, xr, yr};
+}
+
+static double mm_x(const plot_area *a, double wx)
+{
+    return (wx - a->xr.lo) / (a->xr.hi - a->xr.lo) * a->width;
+}
+
+static double mm_y(const plot_area *a, double wy)
+{
+    return (wy - a->yr.lo) / (a->yr.hi - a->yr.lo) * a->height;
+}
+
+static double world_x(const plot_area *a, double mm)
+{
+    return a->xr.lo + mm / a->width * (a->xr.hi - a->xr.lo);
+}
+
+static double world_y(const plot_area *a, double mm)
+{
+    return a->yr.lo + mm / a->height * (a->yr.hi - a->yr.lo);
+}
+
+// Every marker and error bar drawn, as boxes in the area's mm.
+static size_t marker_boxes(size_t ns, const exp_plot_series *s, int log_x, int log_y, const plot_area *a,
+                           double char_mm, exp_plot_box *out, size_t cap)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < ns; ++k) {
+        int marked = s[k].style == EXP_PLOT_POINTS || s[k].style == EXP_PLOT_LINE_POINTS;
+        double shift = s[k].dodge * (a->xr.hi - a->xr.lo), half = marker_half_mm(s[k].marker, char_mm);
+        for (size_t i = 0; i < s[k].n && n + 2 <= cap; ++i) {
+            double x = world(s[k].x[i], log_x) + shift, y = world(s[k].y[i], log_y);
+            if (!isfinite(x) || !isfinite(y) || s[k].style == EXP_PLOT_HLINE) continue;
+            double mx = mm_x(a, x), my = mm_y(a, y);
+            if (marked) out[n++] = (exp_plot_box){mx - half, my - half, mx + half, my + half};
+            double e = s[k].err ? s[k].err[i] : NAN;
+            if (!isfinite(e) || e <= 0) continue;
+            double lo = world(s[k].y[i] - e, log_y), hi = world(s[k].y[i] + e, log_y);
+            lo = isfinite(lo) ? mm_y(a, lo) : 0;
+            if (isfinite(hi)) out[n++] = (exp_plot_box){mx - 0.3 * char_mm, lo, mx + 0.3 * char_mm, mm_y(a, hi)};
+        }
+    }
+    return n;
+}
+
+enum { MAX_NAMES = 256 };
+
+// The names of every series' points, placed clear of each other and of the markers.
+static void draw_names(size_t ns, const exp_plot_series *s, int log_x, int log_y, const plot_area *a, page p)
+{
+    static exp_plot_box obstacles[4 * MAX_NAMES], box[MAX_NAMES];
+    double px[MAX_NAMES], py[MAX_NAMES], w[MAX_NAMES], half[MAX_NAMES];
+    const char *text[MAX_NAMES];
+    int colour[MAX_NAMES];
+    double small_mm = p.char_mm * SMALL / TEXT;
+    size_t n = 0;
+    for (size_t k = 0; k < ns; ++k)
+        for (size_t i = 0; s[k].names && i < s[k].n && n < MAX_NAMES; ++i) {
+            double x = world(s[k].x[i], log_x) + s[k].dodge * (a->xr.hi - a->xr.lo), y = world(s[k].y[i], log_y);
+            if (!s[k].names[i] || !isfinite(x) || !isfinite(y)) continue;
+            px[n] = mm_x(a, x), py[n] = mm_y(a, y), text[n] = s[k].names[i], colour[n] = series_colour(k);
+            w[n] = widest_text(1, &text[n], small_mm), half[n] = marker_half_mm(s[k].marker, p.char_mm);
+            n++;
+        }
+    if (n == 0) return;
+    size_t n_obstacles = marker_boxes(ns, s, log_x, log_y, a, p.char_mm, obstacles, 4 * MAX_NAMES);
+    double mark_mm = 0;
+    for (size_t k = 0; k < n; ++k) mark_mm = fmax(mark_mm, half[k]);
+    exp_plot_place_labels(n, px, py, w, 1.1 * small_mm, mark_mm, 0.4 * p.char_mm, n_obstacles, obstacles, a->width,
+                          a->height, box);
+    text_size(SMALL);
+    plwidth(0.8);
+    for (size_t k = 0; k < n; ++k) {
+        double cy = (box[k].y0 + box[k].y1) / 2, edge = box[k].x0 > px[k] ? box[k].x0 : box[k].x1;
+        plcol0(colour[k]);
+        if (fabs(cy - py[k]) > 0.5 * (box[k].y1 - box[k].y0)) // moved off its row: a line back to the point
+            pljoin(world_x(a, px[k]), world_y(a, py[k]), world_x(a, edge), world_y(a, cy));
+        plptex(world_x(a, box[k].x0), world_y(a, cy), 1, 0, 0, text[k]);
+    }
+    plwidth(1);
+    text_size(TEXT);
+}
+
+// Whether every error bar of a series is shorter than its marker (so hidden
+// behind a filled one): 0 where it has none.
+static int bars_within_marker(const exp_plot_series *s, int log_x, int log_y, const plot_area *a, double char_mm)
+{
+    int any = 0;
+    double half = marker_half_mm(s->marker, char_mm);
+    for (size_t i = 0; s->err && i < s->n; ++i) {
+        double x = world(s->x[i], log_x), e = s->err[i];
+        if (!isfinite(x) || !isfinite(s->y[i]) || !isfinite(e) || e <= 0) continue;
+        double lo = world(s->y[i] - e, log_y), hi = world(s->y[i] + e, log_y);
+        double reach = isfinite(lo) ? (hi - lo) / 2 : INFINITY;
+        if (!(reach / (a->yr.hi - a->yr.lo) * a->height < half)) return 0;
+        any = 1;
+    }
+    return any;
 }
 
 // The legend's entries: one per labelled series, nothing for the others.
@@ -442,11 +643,30 @@ static void legend_add_band(legend *l, const char *text, int colour)
     l->box_pattern[before] = 3; // PLplot's 45° lines
 }
 
-static void legend_of_series(legend *l, size_t ns, const exp_plot_series *s)
+// The notes a series' legend entry carries after its label.
+static char legend_notes[24][320];
+
+// Whether a series draws anything: an entry for a series with nothing drawn
+// would name what the figure does not show.
+static int draws_something(const exp_plot_series *s)
 {
+    for (size_t i = 0; i < s->n; ++i)
+        if (isfinite(s->y[i]) && (s->style == EXP_PLOT_HLINE || isfinite(s->x[i]))) return 1;
+    return 0;
+}
+
+// hidden[k]: series k's error bars are all shorter than its marker (NULL: none is).
+static void legend_of_series(legend *l, size_t ns, const exp_plot_series *s, const int *hidden)
+{
+    *l = (legend){0};
     for (size_t k = 0; k < ns; ++k) {
         int points = s[k].style == EXP_PLOT_POINTS || s[k].style == EXP_PLOT_LINE_POINTS;
-        legend_add(l, s[k].label, series_colour(k), s[k].style != EXP_PLOT_POINTS, s[k].dashed,
+        const char *text = draws_something(&s[k]) ? s[k].label : NULL;
+        if (text && hidden && hidden[k] && l->n < 24) {
+            snprintf(legend_notes[l->n], sizeof legend_notes[0], "%s: error bars shorter than the marker", text);
+            text = legend_notes[l->n];
+        }
+        legend_add(l, text, series_colour(k), s[k].style != EXP_PLOT_POINTS, s[k].dashed,
                    points ? glyph(s[k].marker) : NULL, points ? marker_scale(s[k].marker) : 1);
     }
 }
@@ -505,16 +725,29 @@ int exp_plot_png(const char *path, const exp_plot_axes *a, size_t ns, const exp_
     int log_x = wants_log(a->log_x, ns, s, 0), log_y = wants_log(a->log_y, ns, s, 1);
     range xr = axis_range(a->xlo, a->xhi, data_span(ns, s, 0, log_x), log_x);
     range yr = axis_range(a->ylo, a->yhi, data_span(ns, s, 1, log_y), log_y);
-    legend l = {0};
-    legend_of_series(&l, ns, s);
+    legend l;
+    legend_of_series(&l, ns, s, NULL);
     page p = page_size();
     viewport(p, 2.5 * p.char_mm, &l);
+    // Which series' bars hide behind their markers needs the viewport's height,
+    // which needs the legend's: its entries are redone with the note, the viewport after.
+    int *hidden = calloc(ns ? ns : 1, sizeof *hidden), any_hidden = 0;
+    plot_area area = current_area(p, xr, yr);
+    for (size_t k = 0; hidden && k < ns; ++k)
+        any_hidden |= hidden[k] = s[k].label && bars_within_marker(&s[k], log_x, log_y, &area, p.char_mm);
+    if (any_hidden) {
+        legend_of_series(&l, ns, s, hidden);
+        viewport(p, 2.5 * p.char_mm, &l);
+        area = current_area(p, xr, yr);
+    }
+    free(hidden);
     plwind(xr.lo, xr.hi, yr.lo, yr.hi);
     grid_lines(log_x, log_y);
     for (size_t k = 0; k < ns; ++k) {
         set_colour(series_colour(k), s[k].rgb);
         draw_series(&s[k], series_colour(k), log_x, log_y, xr);
     }
+    draw_names(ns, s, log_x, log_y, &area, p);
     frame(log_x, log_y, xr.lo, xr.hi, yr.lo, yr.hi); // over what was drawn at its edges
     title_and_labels(a->title, a->xlabel, a->ylabel);
     legend_draw(&l, p);
@@ -723,26 +956,60 @@ static void colour_bar(const exp_plot_map *m, const double *levels)
     text_size(TEXT);
 }
 
-// Every evaluated point as a white disc ringed in black (visible on any
-// colour), a failed one as a cross, the chosen one as a large star.
-static void map_markers(const exp_plot_map *m, int chosen_colour)
+static int is_predicted(const exp_plot_map *m, size_t i)
 {
-    for (size_t i = 0; i < m->n; ++i) {
-        double x = m->x[i], y = world(m->y[i], m->log_y);
-        if (!isfinite(x) || !isfinite(y)) continue;
-        plcol0(INK);
-        if (!isfinite(m->z[i])) {
-            mark(x, y, EXP_MARK_CROSS);
-            continue;
+    return m->predicted && m->predicted[i];
+}
+
+// Every measured point as a white disc ringed in black (visible on any
+// colour), a predicted one as a grey open diamond, a failed one as a cross,
+// the chosen one as a large star; the measured over the predicted.
+static void map_markers(const exp_plot_map *m, int chosen_colour, int predicted_colour)
+{
+    for (int pass = 0; pass < 2; ++pass)
+        for (size_t i = 0; i < m->n; ++i) {
+            double x = m->x[i], y = world(m->y[i], m->log_y);
+            if (!isfinite(x) || !isfinite(y) || is_predicted(m, i) != !pass) continue;
+            if (!isfinite(m->z[i])) map_mark(x, y, EXP_MARK_CROSS, INK);
+            else if (is_predicted(m, i)) map_mark(x, y, EXP_MARK_OPEN_DIAMOND, predicted_colour);
+            else map_mark(x, y, EXP_MARK_OPEN_CIRCLE, INK);
         }
-        plcol0(WHITE), mark(x, y, EXP_MARK_CIRCLE);
-        plcol0(INK), mark(x, y, EXP_MARK_OPEN_CIRCLE);
-    }
     if (m->chosen >= 0 && (size_t)m->chosen < m->n) {
         double x = m->x[m->chosen], y = world(m->y[m->chosen], m->log_y);
-        plcol0(chosen_colour);
-        if (isfinite(x) && isfinite(y)) mark(x, y, EXP_MARK_STAR);
+        if (isfinite(x) && isfinite(y)) map_mark(x, y, EXP_MARK_STAR, chosen_colour);
     }
+}
+
+// The search's rectangle, dashed: the axes reach past it.
+static void bounds_box(const map_grid *g)
+{
+    double x[5] = {g->x0, g->x1, g->x1, g->x0, g->x0}, y[5] = {g->y0, g->y0, g->y1, g->y1, g->y0};
+    plcol0(INK);
+    plwidth(1);
+    pllsty(2);
+    plline(5, x, y);
+    pllsty(1);
+}
+
+int exp_plot_band_reached(double lo, double hi, size_t n, const double *z, double *zmin, double *zmax)
+{
+    *zmin = INFINITY, *zmax = -INFINITY;
+    for (size_t i = 0; i < n; ++i)
+        if (isfinite(z[i])) *zmin = fmin(*zmin, z[i]), *zmax = fmax(*zmax, z[i]);
+    if (!isfinite(*zmin)) {
+        *zmin = *zmax = NAN;
+        return 1;
+    }
+    if (!isfinite(lo) && !isfinite(hi)) return 1;
+    return !(isfinite(lo) && lo > *zmax) && !(isfinite(hi) && hi < *zmin);
+}
+
+double exp_plot_settled_from(size_t n, const double *t, const double *y, double tolerance)
+{
+    if (n == 0) return NAN;
+    size_t k = n - 1;
+    while (k > 0 && fabs(y[k - 1] - y[n - 1]) <= tolerance) k--;
+    return t[k];
 }
 
 // Without a fill (points that span no area) each point's value is written beside it.
@@ -767,16 +1034,57 @@ static int any_failed(const exp_plot_map *m)
     return 0;
 }
 
-static legend map_legend(const exp_plot_map *m, int filled, int band_colour, int chosen_colour)
+// The band's legend text, or where the points' values never reach the band
+// that: "not reached", with the range they span.
+static const char *band_text(const exp_plot_map *m, int *reached)
+{
+    static char text[320];
+    double zmin, zmax;
+    *reached = exp_plot_band_reached(m->band_lo, m->band_hi, m->n, m->z, &zmin, &zmax);
+    if (*reached) return m->band_label;
+    snprintf(text, sizeof text, "%s: NOT REACHED, the points span %.3g to %.3g", m->band_label ? m->band_label : "band",
+             zmin, zmax);
+    return text;
+}
+
+static size_t count_predicted(const exp_plot_map *m)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < m->n; ++i) n += is_predicted(m, i);
+    return n;
+}
+
+static legend map_legend(const exp_plot_map *m, int filled, int band_colour, int chosen_colour, int predicted_colour)
 {
     legend l = {0};
     legend_add(&l, m->points_label ? m->points_label : "evaluated", INK, 0, 0, glyph(EXP_MARK_OPEN_CIRCLE), 1);
+    if (count_predicted(m))
+        legend_add(&l, m->predicted_label ? m->predicted_label : "predicted, not measured", predicted_colour, 0, 0,
+                   glyph(EXP_MARK_OPEN_DIAMOND), 1);
     if (any_failed(m)) legend_add(&l, "failed run", INK, 0, 0, glyph(EXP_MARK_CROSS), 1);
     if (m->chosen >= 0)
         legend_add(&l, m->chosen_label ? m->chosen_label : "chosen", chosen_colour, 0, 0, glyph(EXP_MARK_STAR), 1.4);
-    if (filled && (isfinite(m->band_lo) || isfinite(m->band_hi)))
-        legend_add_band(&l, m->band_label, band_colour);
+    int reached = 1;
+    const char *band = band_text(m, &reached);
+    if (!reached) { // no line to show: the text alone, in the chosen star's red
+        legend_add(&l, band, chosen_colour, 0, 0, NULL, 1);
+        l.text_colour[l.n - 1] = chosen_colour;
+    } else if (filled && (isfinite(m->band_lo) || isfinite(m->band_hi)))
+        legend_add_band(&l, band, band_colour);
+    legend_add(&l, "search bounds", INK, 1, 1, NULL, 1);
+    l.style[l.n - 1] = 2, l.width[l.n - 1] = 1;
     return l;
+}
+
+// How far the axes reach past the rectangle (world units): a star's half
+// width and a little, so that a marker on the rectangle's edge is drawn whole.
+static void pad_window(const map_grid *g, page p, double *px, double *py)
+{
+    PLFLT x0, x1, y0, y1;
+    plgvpd(&x0, &x1, &y0, &y1);
+    double reach_mm = marker_half_mm(EXP_MARK_STAR, p.char_mm) + 0.3 * p.char_mm;
+    double fx = reach_mm / ((x1 - x0) * p.width), fy = reach_mm / ((y1 - y0) * p.height);
+    *px = fx / (1 - 2 * fx) * (g->x1 - g->x0), *py = fy / (1 - 2 * fy) * (g->y1 - g->y0);
 }
 
 int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int height, char *err, size_t len)
@@ -791,12 +1099,14 @@ int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int hei
     figure f;
     if (begin_figure(&f, path, width, height, err, len)) return free(g), 1;
     interpolate(m, g);
-    enum { BAND = FIRST_SERIES_COLOUR, CHOSEN };
-    plscol0(BAND, 0, 0, 0), plscol0(CHOSEN, 215, 25, 28);
-    legend l = map_legend(m, g->filled, BAND, CHOSEN);
+    enum { BAND = FIRST_SERIES_COLOUR, CHOSEN, PREDICTED };
+    plscol0(BAND, 0, 0, 0), plscol0(CHOSEN, 215, 25, 28), plscol0(PREDICTED, 90, 90, 90);
+    legend l = map_legend(m, g->filled, BAND, CHOSEN, PREDICTED);
     page p = page_size();
     viewport(p, (g->filled ? 10 : 2.5) * p.char_mm, &l);
-    plwind(g->x0, g->x1, g->y0, g->y1);
+    double pad_x, pad_y;
+    pad_window(g, p, &pad_x, &pad_y);
+    plwind(g->x0 - pad_x, g->x1 + pad_x, g->y0 - pad_y, g->y1 + pad_y);
     double levels[MAP_LEVELS];
     if (g->filled) {
         sequential_colours();
@@ -807,12 +1117,141 @@ int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int hei
         if (isfinite(m->band_hi)) contour(g, m->band_hi);
         plwidth(1);
     }
-    frame(0, m->log_y, g->x0, g->x1, g->y0, g->y1);
-    map_markers(m, CHOSEN);
+    bounds_box(g);
+    frame(0, m->log_y, g->x0 - pad_x, g->x1 + pad_x, g->y0 - pad_y, g->y1 + pad_y);
+    map_markers(m, CHOSEN, PREDICTED);
     if (!g->filled) map_values(m, g);
     if (g->filled) colour_bar(m, levels);
     title_and_labels(m->title, m->xlabel, m->ylabel);
     legend_draw(&l, p);
     free(g);
+    return end_figure(&f, err, len);
+}
+
+// ---- corner plots ---------------------------------------------------------------------
+
+enum { CORNER_BINS = 30, CORNER_MAX_POINTS = 4000 };
+
+// Counts of v (world coordinates) in CORNER_BINS bins over [lo, hi], as a
+// fraction of the largest, at each bin's left edge (plbin's layout).
+static void histogram(size_t n, const double *v, int log, double lo, double hi, double *edge, double *height)
+{
+    double count[CORNER_BINS] = {0}, most = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double w = world(v[i], log);
+        if (!isfinite(w)) continue;
+        int b = (int)((w - lo) / (hi - lo) * CORNER_BINS);
+        if (b >= 0 && b <= CORNER_BINS) count[b < CORNER_BINS ? b : CORNER_BINS - 1]++;
+    }
+    for (int b = 0; b < CORNER_BINS; ++b) most = fmax(most, count[b]);
+    for (int b = 0; b < CORNER_BINS; ++b)
+        edge[b] = lo + (hi - lo) * b / CORNER_BINS, height[b] = most > 0 ? count[b] / most : 0;
+}
+
+// A vertical (x) or horizontal (y) line across the current window, dashed or solid.
+static void corner_line(int vertical, double at, int dashed, double w0, double w1)
+{
+    if (!isfinite(at)) return;
+    PLFLT x[2] = {at, at}, y[2] = {w0, w1};
+    pllsty(dashed ? 2 : 1);
+    if (vertical) plline(2, x, y);
+    else plline(2, y, x);
+    pllsty(1);
+}
+
+// One histogram panel: bars along x (vertical = 0: the y histogram drawn sideways).
+static void corner_histogram(const exp_plot_corner *c, int of_y, double lo, double hi)
+{
+    double edge[CORNER_BINS], height[CORNER_BINS];
+    double s0 = of_y ? world(c->ylo, c->log_y) : c->xlo, s1 = of_y ? world(c->yhi, c->log_y) : c->xhi;
+    histogram(c->n, of_y ? c->y : c->x, of_y && c->log_y, s0, s1, edge, height);
+    if (of_y) plwind(0, 1.05, lo, hi);
+    else plwind(lo, hi, 0, 1.05);
+    plcol0(FIRST_SERIES_COLOUR);
+    for (int b = 0; b < CORNER_BINS; ++b) { // each bin a filled box, drawn as the plot's axes run
+        double w = (s1 - s0) / CORNER_BINS;
+        PLFLT bx[4] = {edge[b], edge[b] + w, edge[b] + w, edge[b]}, by[4] = {0, 0, height[b], height[b]};
+        if (of_y) plfill(4, by, bx);
+        else plfill(4, bx, by);
+    }
+    plcol0(INK);
+    double med = of_y ? world(c->y_median, c->log_y) : c->x_median;
+    double q_lo = of_y ? world(c->y_lo, c->log_y) : c->x_lo, q_hi = of_y ? world(c->y_hi, c->log_y) : c->x_hi;
+    corner_line(!of_y, med, 0, 0, 1.05);
+    corner_line(!of_y, q_lo, 1, 0, 1.05);
+    corner_line(!of_y, q_hi, 1, 0, 1.05);
+    plbox(of_y ? "bc" : "bc", 0, 0, of_y ? "bcst" : "bc", 0, 0);
+}
+
+// The joint panel: the samples (at most CORNER_MAX_POINTS, evenly taken), the medians and intervals, the choice.
+static void corner_joint(const exp_plot_corner *c, double x0, double x1, double y0, double y1, int chosen_colour)
+{
+    plwind(x0, x1, y0, y1);
+    grid_lines(0, c->log_y);
+    size_t every = c->n > CORNER_MAX_POINTS ? c->n / CORNER_MAX_POINTS : 1;
+    text_size(0.35);
+    plcol0(FIRST_SERIES_COLOUR);
+    for (size_t i = 0; i < c->n; i += every) {
+        double x = c->x[i], y = world(c->y[i], c->log_y);
+        if (isfinite(x) && isfinite(y)) plstring(1, &x, &y, "•");
+    }
+    text_size(TEXT);
+    plcol0(INK);
+    corner_line(1, c->x_median, 0, y0, y1), corner_line(1, c->x_lo, 1, y0, y1), corner_line(1, c->x_hi, 1, y0, y1);
+    corner_line(0, world(c->y_median, c->log_y), 0, x0, x1);
+    corner_line(0, world(c->y_lo, c->log_y), 1, x0, x1), corner_line(0, world(c->y_hi, c->log_y), 1, x0, x1);
+    double cy = world(c->chosen_y, c->log_y);
+    if (isfinite(c->chosen_x) && isfinite(cy)) map_mark(c->chosen_x, cy, EXP_MARK_STAR, chosen_colour);
+    frame(0, c->log_y, x0, x1, y0, y1);
+}
+
+// The free corner's text, one line under the other from its top.
+static void corner_note(const char *note)
+{
+    if (!note) return;
+    plwind(0, 1, 0, 1);
+    plcol0(INK);
+    text_size(SMALL);
+    char line[256];
+    double at = 0.92;
+    for (const char *p = note; *p; at -= 0.11) {
+        size_t k = strcspn(p, "\n");
+        snprintf(line, sizeof line, "%.*s", (int)(k < 255 ? k : 255), p);
+        plptex(0.02, at, 1, 0, 0, line);
+        p += k + (p[k] == '\n');
+    }
+    text_size(TEXT);
+}
+
+int exp_plot_corner_png(const char *path, const exp_plot_corner *c, int width, int height, char *err, size_t len)
+{
+    figure f;
+    if (begin_figure(&f, path, width, height, err, len)) return 1;
+    enum { CHOSEN = FIRST_SERIES_COLOUR + 1 };
+    double rgb[3];
+    exp_plot_colour(0, rgb);
+    set_colour(FIRST_SERIES_COLOUR, rgb);
+    plscol0(CHOSEN, 215, 25, 28);
+    page p = page_size();
+    double left = 8.0 * p.char_mm, bottom = 4.4 * p.char_mm, top = 3.2 * p.char_mm, right = 2.5 * p.char_mm;
+    double gap = 1.0 * p.char_mm;
+    double a_w = (p.width - left - right - gap) * 0.7, a_h = (p.height - bottom - top - gap) * 0.7;
+    double b_w = p.width - left - right - gap - a_w, b_h = p.height - bottom - top - gap - a_h;
+    // The windows reach 3 % past the support, so that a star on a bound is whole.
+    double y0 = world(c->ylo, c->log_y), y1 = world(c->yhi, c->log_y), pad_y = 0.03 * (y1 - y0);
+    double pad_x = 0.03 * (c->xhi - c->xlo), x0 = c->xlo - pad_x, x1 = c->xhi + pad_x;
+    y0 -= pad_y, y1 += pad_y;
+    plsvpa(left, left + a_w, bottom, bottom + a_h); // joint, below left
+    corner_joint(c, x0, x1, y0, y1, CHOSEN);
+    plcol0(INK);
+    plmtex("b", 3.2, 0.5, 0.5, c->xlabel);
+    plmtex("l", ylabel_offset(), 0.5, 0.5, c->ylabel);
+    plsvpa(left, left + a_w, bottom + a_h + gap, bottom + a_h + gap + b_h); // x histogram above
+    corner_histogram(c, 0, x0, x1);
+    if (c->title) text_size(TITLE), plmtex("t", 1.2, 0.0, 0.0, c->title), text_size(TEXT);
+    plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom, bottom + a_h); // y histogram to the right
+    corner_histogram(c, 1, y0, y1);
+    plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom + a_h + gap, bottom + a_h + gap + b_h);
+    corner_note(c->note);
     return end_figure(&f, err, len);
 }

@@ -20,7 +20,7 @@ exp_silo_def exp_default_silo_def(void)
 {
     exp_silo_def d;
     memset(&d, 0, sizeof d);
-    d.gsd = (dem_gsd){1.0, 1.1, 2.0}; // Table A.2: d50 = 1 m, σ_geo = 1.1
+    d.gsd = dem_gsd_lognormal(1.0, 1.1, 2.0); // Table A.2: d50 = 1 m, σ_geo = 1.1
     d.density = 500;
     // Table A.2: k_n = k_s = 50 000 N/m, k_r = 0, ξ = 0, μ_s = 0.5, μ_r = 0.
     d.granule = (dem_contact_params){50000, 50000, 0, 0, 0.5, 0, EXP_DAMPING_DEFAULT};
@@ -365,7 +365,7 @@ int exp_is_silo_config(const char *path) { return exp_yaml_starts_with(path, "ex
 static void to_def(const silo_yaml *y, exp_silo_def *d)
 {
     *d = exp_default_silo_def();
-    d->gsd = (dem_gsd){y->median_diameter, y->geometric_sd, y->truncation_sigmas};
+    d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
     d->density = y->density;
     // Table A.2: no rolling (k_r = μ_r = 0), one damping ratio for all contacts.
     d->granule = (dem_contact_params){y->k_n, y->k_s, 0, y->xi, y->mu_s, 0, EXP_DAMPING_DEFAULT};

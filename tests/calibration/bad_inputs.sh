@@ -53,7 +53,17 @@ expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perh
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
 expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm 's/^    max_time: 1.5/    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
-expect "unknown tier" "tier: 'fast'" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
+# A tier the user asked for names the option, the file and the tiers it has; one the file names, its line.
+tiers=$(sed -n 's/^  - name: \(.*\)/\1/p' "$work/configs/good.yaml" | paste -sd, | sed 's/,/, /g')
+expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
+expect "unknown tier in the file" "good_tier.yaml:$(grep -n '^tier:' "$work/configs/good.yaml" | cut -d: -f1): tier: 'fast' is not one of its tiers: $tiers" -- "$(edit good_tier 's/^tier: quick/tier: fast/')" "${out[@]}"
+cmd=synthesize expect "synthesize: unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
+cmd=study expect "study: unknown rung" "--rungs L1000-slice9-avg8,L3-full: 'L3-full' is not a rung of $work/configs/good.yaml (fidelity.rungs); its rungs: L65536-slice40, " -- fidelity "$work/configs/good.yaml" --rungs L1000-slice9-avg8,L3-full "${out[@]}"
+# A measured size table (gsd_table): its rows checked and named; not with the log-normal's keys; its basis required.
+printf 'size_um,cumulative_percent\n100,0\n200,40\n300,30\n400,100\n' > "$work/configs/psd.csv"
+expect "size table decreasing" "psd.csv:4: cumulative_percent: 30 is below the row above (40)" -- "$(edit psd 's/^median_diameter: .*/gsd_table: psd.csv\ngsd_basis: volume/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
+expect "size table and log-normal" "median_diameter: gsd_table gives the size distribution" -- "$(edit psd_both 's/^density: 1800 .*/density: 1800\ngsd_table: psd.csv\ngsd_basis: volume/')" "${out[@]}"
+expect "size table without basis" "gsd_basis: 'absent'" -- "$(edit psd_basis 's/^median_diameter: .*/gsd_table: psd.csv/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
 expect "unknown material" "--material 'granite'" -- "$work/configs/good.yaml" --material granite "${out[@]}"
 expect "unknown stage" "--stage 'polish'" -- "$work/configs/good.yaml" --stage polish "${out[@]}"
 expect "empty CSV" "empty.csv:1: header" -- "$(csv empty '')" "${out[@]}"
@@ -66,9 +76,9 @@ expect "extra fields, angle file" "extra_angle.csv:2: row: has 7 fields, expecte
 expect "extra fields, CSA file" "extra_csa.csv:3: row: has 7 fields, expected 4" -- "$(csa extra_csa '# lab\nsurface,rpm,csa_percent,csa_sd_percent\nPTFE,4,45,0.5,1,2,3\nPTFE,40,50,0.5\n')" "${out[@]}"
 expect "surface missing" "no row for surface 'PP'" -- "$(csv nopp 'surface,rpm,angle_deg,angle_sd_deg\nPTFE,4,31.9,0.5\nAluminium,4,34.2,0.5\nspray-dried powder,4,34.6,0.5\n')" "${out[@]}"
 expect "unwritable results" "/proc/granucal" -- "$work/configs/good.yaml" --out /proc/granucal
-expect "a plan over the budget" "over --budget-hours 0.001: nothing was run" -- "$work/configs/good.yaml" --tier ci --budget-hours 0.001 "${out[@]}"
+expect "a plan over the budget" "over --budget-hours 0.001, which judges the expected figure: nothing was run" -- "$work/configs/good.yaml" --tier ci --budget-hours 0.001 "${out[@]}"
 # Stage 1 alone has no drum run: its poured cylinders are predicted and refused too.
-expect "stage 1 over the budget" "0 drum runs and 10 poured cylinders" -- "$work/configs/good.yaml" --tier ci --stage stiffness --budget-hours 0.0001 "${out[@]}"
+expect "stage 1 over the budget" "over --budget-hours 0.0001, which judges the expected figure" -- "$work/configs/good.yaml" --tier ci --stage stiffness --budget-hours 0.0001 "${out[@]}"
 expect "a budget not a number" "--budget-hours 'soon'" -- "$work/configs/good.yaml" --budget-hours soon "${out[@]}"
 expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
 expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
@@ -82,12 +92,45 @@ cmd=synthesize expect "twin: on the candidates' own bed" "--seeds: 2 is a bed of
 # stops with exit 0 before making the results folder.
 expect "negative friction under --plan" "pour_mu_s.yaml:" -- "$work/configs/pour_mu_s.yaml" --plan "${out[@]}"
 plan=$(timeout 20 "$bin" calibrate "$work/configs/good.yaml" --tier ci --jobs 2 --plan "${out[@]}" 2>&1 >/dev/null); code=$?
-if [ $code -eq 0 ] && grep -q "^== plan: at most [0-9]* drum runs and [0-9]* poured cylinders, predicted .* on 2 worker" <<< "$plan" &&
+if [ $code -eq 0 ] && grep -q "^== plan: expected [0-9]* simulations, .* on 2 worker(s); worst case [0-9]* simulations, .* h on 2 worker" <<< "$plan" &&
    grep -qF -- "--plan: every input checked, nothing was run" <<< "$plan"; then
   echo "ok   --plan: $(head -1 <<< "$plan")"
 else
   echo "FAIL --plan: exit $code: $plan"; fails=$((fails + 1))
 fi
+# An unknown option, or a missing value, of any command: one line naming it and where the options are.
+for c in calibrate simulate measure "study fidelity" synthesize; do
+  for bad in --frobnicate "--out"; do
+    msg=$(timeout 20 "$bin" $c $bad 2>&1 >/dev/null); code=$?
+    if [ $code -eq 2 ] && [ "$(wc -l <<< "$msg")" -eq 1 ] && grep -qF -- "'$bad'; see \`granucal $c --help\`" <<< "$msg"; then
+      echo "ok   $c $bad: $msg"
+    else echo "FAIL $c $bad: exit $code, wanted one line naming '$bad' and \`granucal $c --help\`: $msg"; fails=$((fails + 1)); fi
+  done
+done
+# A wall lining the drum config does not have: the error lists those it has.
+drum_walls=$(sed -n 's/^  - {name: \([^,]*\),.*/\1/p' "$src/configs/drum.yaml" | paste -sd, | sed 's/,/, /g')
+cmd=simulate expect "unknown wall material" "wall = 'Steel': not 'granules' nor a name under materials; the walls are: granules, $drum_walls" -- "$src/configs/drum.yaml" --set wall=Steel --out "$work/out"
+# measure prints JSON: a number it does not have (the spread of one measured photo) is null, not nan.
+json=$(cd "$src" && timeout 60 "$bin" measure results/measure/photo.png "$work/no_such_photo.png" 2>/dev/null)
+if python3 -c 'import json, sys
+bad = lambda c: sys.exit("not JSON: " + c)
+rows = [json.loads(l, parse_constant=bad) for l in sys.stdin.read().splitlines()]
+assert rows[-1]["measured"] == 1 and rows[-1]["angle_sd_deg"] is None and rows[-1]["csa_sd_percent"] is None, rows[-1]' <<< "$json"; then
+  echo "ok   measure: strict JSON, null for the spread of one photo: $(tail -1 <<< "$json")"
+else echo "FAIL measure: not strict JSON with null spreads: $json"; fails=$((fails + 1)); fi
+# synthesize --plan and study --plan: the plan (expected and worst case), exit 0, nothing run or made.
+for c in "synthesize $work/configs/good.yaml --tier ci ${walls[*]}" "study fidelity $work/configs/good.yaml --rungs L4096-slice15"; do
+  msg=$(timeout 20 "$bin" $c --jobs 2 --plan "${out[@]}" 2>&1 >/dev/null); code=$?
+  if [ $code -eq 0 ] && grep -q "^== plan: .*expected [0-9.e+]* core-hours, .* h on 2 worker(s); worst case [0-9.e+]* core-hours" <<< "$msg" &&
+     grep -q -- "--plan: .*nothing was run" <<< "$msg"; then echo "ok   ${c%% *} --plan: $(grep '^== plan: ' <<< "$msg" | tail -1)"
+  else echo "FAIL ${c%% *} --plan: exit $code: $msg"; fails=$((fails + 1)); fi
+done
+# study without --rungs: the whole ladder's plan, then a line asking for --yes, exit 2, nothing run.
+msg=$(timeout 20 "$bin" study fidelity "$work/configs/good.yaml" --jobs 2 "${out[@]}" 2>&1 >/dev/null); code=$?
+if [ $code -eq 2 ] && grep -q "^== plan: study fidelity" <<< "$msg" && grep -q "^   L8-full " <<< "$msg" &&
+   [ "$(tail -1 <<< "$msg")" = "granucal study: no --rungs: the plan above is the whole ladder; run it with --yes, or choose rungs with --rungs A,B (nothing was run)" ]; then
+  echo "ok   study without --rungs: $(tail -1 <<< "$msg")"
+else echo "FAIL study without --rungs: exit $code: $msg"; fails=$((fails + 1)); fi
 [ -e "$work/out" ] && { echo "FAIL: a refused run left $work/out behind"; fails=$((fails + 1)); }
 echo "$fails failure(s)"
 exit $((fails > 0))

@@ -22,7 +22,7 @@ fidelity:
     - {name: L8-full, lambda: 8, slice_depth: 0, max_time: 6.0, window: 1.0}
 YAML
 cd "$src"
-"$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 > "$work/run1.log" 2>&1 || { cat "$work/run1.log"; exit 1; }
+"$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 --yes > "$work/run1.log" 2>&1 || { cat "$work/run1.log"; exit 1; }
 summary="$work/out/fidelity_summary.csv"
 cat "$summary"
 field() { awk -F, -v r="$1" -v c="$2" 'NR==1{for(i=1;i<=NF;i++)h[$i]=i;next} $1==r{print $h[c]}' "$summary"; }
@@ -44,7 +44,7 @@ for f in fidelity.csv fidelity.md fidelity_error_vs_cost.png fidelity_vs_lambda.
   [ -s "$work/out/$f" ] || { echo "missing $f"; exit 1; }
 done
 # A rerun reads every simulation back from the store.
-"$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 > "$work/run2.log" 2>&1 || { cat "$work/run2.log"; exit 1; }
+"$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 --yes > "$work/run2.log" 2>&1 || { cat "$work/run2.log"; exit 1; }
 if grep -q "simulated in" "$work/run2.log"; then echo "the rerun simulated again"; cat "$work/run2.log"; exit 1; fi
 # The committed ladder (results/fidelity_ladder/store), read back at 4 rpm: lambda 1000 lies inside the
 # 1 deg band of lambda 512 but 0.93 +- 0.15 deg above it (6.2 standard errors of the difference, from the

@@ -384,7 +384,28 @@ static void test_store_round_trip_and_collision_check(void **state)
     write_file(path, "key: 'x\nstatus: [\n");
     assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
     assert_non_null(strstr(err, path));
-    unlink(path);
+    assert_int_equal(access(path, F_OK), 0); // cal_store_get changes nothing
+    // A run that reruns what is missing (cal_store_lookup) moves it aside,
+    // kept, and finds it absent; a record cut within its last line is damaged too.
+    char aside[1300], hash[17];
+    cal_store_hash(r.key, hash);
+    snprintf(aside, sizeof aside, "%s/damaged/%s.yaml", dir, hash);
+    assert_int_equal(cal_store_lookup(dir, r.key, &back, err, sizeof err), 1);
+    assert_int_equal(access(path, F_OK), -1);
+    assert_int_equal(access(aside, F_OK), 0);
+    assert_int_equal(cal_store_put(dir, &r, err, sizeof err), 0);
+    FILE *whole = fopen(path, "r");
+    assert_non_null(whole);
+    size_t n = fread(text, 1, sizeof text - 1, whole);
+    fclose(whole);
+    text[n - 2] = 0; // "granules: 56" of 566, no line break
+    write_file(path, text);
+    assert_int_equal(cal_store_get(dir, r.key, &back, err, sizeof err), -1);
+    assert_non_null(strstr(err, "cut short"));
+    assert_int_equal(cal_store_lookup(dir, r.key, &back, err, sizeof err), 1);
+    unlink(aside);
+    snprintf(aside, sizeof aside, "%s/damaged", dir);
+    rmdir(aside);
     rmdir(dir);
 }
 

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
@@ -86,11 +87,60 @@ static void test_malformed_file(void **state)
     remove(path);
 }
 
+// configs/drum.yaml with its log-normal's three lines replaced by `lines`, in a temporary file.
+static void write_drum_with(const char *path, const char *lines)
+{
+    FILE *in = fopen(config, "r"), *out = fopen(path, "w");
+    assert_non_null(in);
+    assert_non_null(out);
+    char text[512];
+    while (fgets(text, sizeof text, in)) {
+        if (strncmp(text, "median_diameter:", 16) == 0) fputs(lines, out);
+        else if (strncmp(text, "geometric_sd:", 13) && strncmp(text, "truncation_sigmas:", 18)) fputs(text, out);
+    }
+    fclose(in), fclose(out);
+}
+
+// A measured size table instead of the log-normal (configs/examples/psd_volume.csv, by volume: its
+// number median about 200 um); both at once, or a table without its basis, refused with the key named.
+static void test_gsd_table(void **state)
+{
+    (void)state;
+    const char *src = getenv("GRANUCAL_SOURCE_DIR");
+    char path[] = "/tmp/granucal_drum_table_XXXXXX", lines[1200], err[512];
+    close(mkstemp(path));
+    snprintf(lines, sizeof lines, "gsd_table: %s/configs/examples/psd_volume.csv\ngsd_basis: volume\n", src ? src : ".");
+    write_drum_with(path, lines);
+    exp_drum_yaml *y = exp_drum_config_load(path, 0, NULL, err, sizeof err);
+    if (!y) fail_msg("%s", err);
+    exp_drum_def d;
+    exp_drum_run_opts r;
+    assert_int_equal(exp_drum_config_defs(y, &d, &r, err, sizeof err), 0);
+    printf("table: %d rows, number median %.1f um, %.0f-%.0f um\n", d.gsd.table.rows, 1e6 * d.gsd.median_diameter,
+           1e6 * dem_gsd_min_diameter(&d.gsd), 1e6 * dem_gsd_max_diameter(&d.gsd));
+    assert_int_equal(d.gsd.table.rows, 18);
+    assert_true(d.gsd.median_diameter > 195e-6 && d.gsd.median_diameter < 205e-6);
+    exp_drum_config_free(y);
+    const struct { const char *extra, *needle; } bad[] = {
+        {"median_diameter: 200e-6\n", "median_diameter: gsd_table gives the size distribution"},
+        {"", "gsd_basis: 'absent'"}};
+    for (size_t k = 0; k < 2; ++k) {
+        snprintf(lines, sizeof lines, "gsd_table: %s/configs/examples/psd_volume.csv\n%s%s", src ? src : ".",
+                 k ? "" : "gsd_basis: volume\n", bad[k].extra);
+        write_drum_with(path, lines);
+        assert_null(exp_drum_config_load(path, 0, NULL, err, sizeof err));
+        printf("-> %s\n", err);
+        if (!strstr(err, bad[k].needle)) fail_msg("message '%s' lacks '%s'", err, bad[k].needle);
+    }
+    remove(path);
+}
+
 int main(void)
 {
     const char *src = getenv("GRANUCAL_SOURCE_DIR");
     snprintf(config, sizeof config, "%s/configs/drum.yaml", src ? src : ".");
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_shipped_config_loads), cmocka_unit_test(test_overrides),
-                                       cmocka_unit_test(test_bad_values_named), cmocka_unit_test(test_malformed_file)};
+                                       cmocka_unit_test(test_bad_values_named), cmocka_unit_test(test_malformed_file),
+                                       cmocka_unit_test(test_gsd_table)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,6 +19,7 @@
 #include <math.h>
 #include <png.h>
 
+#include "cal_data.h"
 #include "cal_figures.h"
 #include "exp_plot.h"
 
@@ -193,6 +194,133 @@ static void friction_figures(void **state)
     free(r);
 }
 
+// A two-tier stage: this tier's runs, then the map tier's candidates with the
+// correction (predicted), the target angle below every value of the map; the
+// data synthetic. Drawn: the files are written (the look was checked by eye).
+static void two_tier_figures_with_the_target_not_reached(void **state)
+{
+    cal_friction_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    cal_bounds b = {0.1, 1.0, 1e-5, 0.5};
+    char err[512];
+    friction_stage(r, 3);
+    snprintf(r->material, sizeof r->material, "PP");
+    snprintf(r->map_tier, sizeof r->map_tier, "ci");
+    r->angle_target = 20; // below every candidate's angle
+    r->csa_source = (cal_provenance){1, 512};
+    for (int i = 5; i < r->n; ++i) r->cand[i].predicted = 1;
+    r->cand[0].mu_s = 1.0, r->cand[0].mu_r = 0.5, r->best = 0; // the chosen on the bounds' corner
+    if (cal_figures_friction(dir, &b, r, err, sizeof err)) fail_msg("%s", err);
+    assert_figure("angle_map_PP.png", 20000, 20);
+    assert_figure("convergence_PP.png", 8000, 6);
+    assert_figure("csa_vs_rpm_PP.png", 8000, 6);
+    free(r);
+}
+
+// ---- pure helpers --------------------------------------------------------------------
+
+static void band_reached_or_not(void **state)
+{
+    double z[5] = {45.1, NAN, 47.8, 46.0, 45.5}, lo, hi;
+    assert_int_equal(exp_plot_band_reached(38.2, 41.6, 5, z, &lo, &hi), 0); // wholly below
+    assert_float_equal(lo, 45.1, 1e-12);
+    assert_float_equal(hi, 47.8, 1e-12);
+    assert_int_equal(exp_plot_band_reached(48, 50, 5, z, &lo, &hi), 0);       // wholly above
+    assert_int_equal(exp_plot_band_reached(44, 45.2, 5, z, &lo, &hi), 1);     // meets the lowest
+    assert_int_equal(exp_plot_band_reached(NAN, 45.0, 5, z, &lo, &hi), 0);    // open below, still under
+    assert_int_equal(exp_plot_band_reached(NAN, 46.0, 5, z, &lo, &hi), 1);
+    assert_int_equal(exp_plot_band_reached(NAN, NAN, 5, z, &lo, &hi), 1);     // no band
+    double none[2] = {NAN, NAN};
+    assert_int_equal(exp_plot_band_reached(1, 2, 2, none, &lo, &hi), 1);      // nothing to judge by
+    assert_true(isnan(lo) && isnan(hi));
+}
+
+static void settled_from_the_last_change(void **state)
+{
+    double t[8] = {0, 1, 2, 3, 4, 5, 6, 7}, y[8] = {0, 10, 50, 90, 95, 96, 96, 96};
+    assert_float_equal(exp_plot_settled_from(8, t, y, 0.5), 5, 1e-12);
+    assert_float_equal(exp_plot_settled_from(8, t, y, 1.5), 4, 1e-12); // within the tolerance of the last value
+    double rising[3] = {1, 2, 3};
+    assert_float_equal(exp_plot_settled_from(3, t, rising, 0.1), 2, 1e-12); // never settles: its end
+    assert_true(isnan(exp_plot_settled_from(0, t, y, 0.5)));
+}
+
+static int overlap(const exp_plot_box *a, const exp_plot_box *b)
+{
+    return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
+}
+
+// Six long names on points one over another (two rungs of one λ, as the
+// fidelity ladder has): no name over another, over a marker, or out of the area.
+static void labels_placed_without_collisions(void **state)
+{
+    enum { N = 6 };
+    double px[N] = {100, 100.5, 101, 100, 150, 290}, py[N] = {50, 51, 50.5, 49, 50, 50}, w[N], h = 4.5, mark = 2.3;
+    exp_plot_box markers[N], box[N];
+    for (int k = 0; k < N; ++k) {
+        w[k] = 45;
+        markers[k] = (exp_plot_box){px[k] - mark, py[k] - mark, px[k] + mark, py[k] + mark};
+    }
+    assert_int_equal(exp_plot_place_labels(N, px, py, w, h, mark, 2, N, markers, 300, 170, box), 0);
+    for (int k = 0; k < N; ++k) {
+        assert_true(box[k].x0 >= 0 && box[k].y0 >= 0 && box[k].x1 <= 300 && box[k].y1 <= 170);
+        assert_true(fabs(box[k].x1 - box[k].x0 - w[k]) < 1e-9);
+        for (int j = 0; j < N; ++j) {
+            if (overlap(&box[k], &markers[j])) fail_msg("name %d over marker %d", k, j);
+            if (j != k && overlap(&box[k], &box[j])) fail_msg("names %d and %d collide", k, j);
+        }
+    }
+    // The point at x 290 has no room on its right: its name goes to the left.
+    assert_true(box[5].x1 <= px[5]);
+    // An area too small for all of them: the ones left over are counted.
+    assert_true(exp_plot_place_labels(N, px, py, w, h, mark, 2, N, markers, 300, 12, box) > 0);
+}
+
+static void speed_axis_of_one_and_of_several_speeds(void **state)
+{
+    double one[1] = {116};
+    cal_speed_axis a = cal_figures_speed_axis(1, one, 5);
+    assert_true(a.lo < 116 && a.hi > 116 && a.hi - a.lo <= 5); // around it, not 105-127
+    assert_float_equal((a.lo + a.hi) / 2, 116, 1e-9);
+    assert_true(a.widest_shift < (a.hi - a.lo) / 2);            // every series inside the axis
+    double several[5] = {4, 40, 80, 105, 116};
+    a = cal_figures_speed_axis(5, several, 6);
+    assert_true(a.lo < 4 && a.hi > 116);
+    assert_true(a.widest_shift <= 0.015 * (a.hi - a.lo)); // small beside the axis (±1.5 rpm on 4-116)
+    assert_float_equal(cal_figures_speed_axis(5, several, 1).widest_shift, 0, 0);
+    assert_float_equal(cal_figures_dodge(0, 0.01), 0, 0);
+    assert_float_equal(cal_figures_dodge(1, 0.01), -0.01, 1e-15);
+    assert_float_equal(cal_figures_dodge(2, 0.01), 0.01, 1e-15);
+    assert_float_equal(cal_figures_dodge(3, 0.01), -0.02, 1e-15);
+}
+
+// The CSA file's SYNTHETIC header is kept with the series, and its λ.
+static void synthetic_data_known_from_the_header(void **state)
+{
+    char path[1200], err[512];
+    path_in_dir(path, sizeof path, "occupied_area.csv");
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("# SYNTHETIC stand-in, made by a script.\n# SYNTHETIC - not lab data. made by tier 'fine' (lambda 512, "
+          "periodic slice)\nsurface,rpm,csa_percent,csa_sd_percent\nPP,4,45.2,0.1\n",
+          f);
+    fclose(f);
+    cal_series s;
+    if (cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(s.synthetic, 1);
+    assert_float_equal(s.synthetic_lambda, 512, 0);
+    cal_series_free(&s);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("# lab measurements (lambda 1 would be the real powder)\nsurface,rpm,csa_percent,csa_sd_percent\nPP,4,45.2,0.1\n", f);
+    fclose(f);
+    if (cal_series_load(&s, path, CAL_DATA_CSA, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(s.synthetic, 0);
+    assert_true(isnan(s.synthetic_lambda));
+    cal_series_free(&s);
+    remove(path);
+}
+
 // Two points span no area: the map has nothing to fill, but its markers
 // and axes are still drawn and the call succeeds.
 static void map_of_too_few_points(void **state)
@@ -251,6 +379,12 @@ int main(void)
         cmocka_unit_test(chart_on_log_axes),
         cmocka_unit_test(stiffness_sweep),
         cmocka_unit_test(friction_figures),
+        cmocka_unit_test(two_tier_figures_with_the_target_not_reached),
+        cmocka_unit_test(band_reached_or_not),
+        cmocka_unit_test(settled_from_the_last_change),
+        cmocka_unit_test(labels_placed_without_collisions),
+        cmocka_unit_test(speed_axis_of_one_and_of_several_speeds),
+        cmocka_unit_test(synthetic_data_known_from_the_header),
         cmocka_unit_test(map_of_too_few_points),
         cmocka_unit_test(map_of_a_square_grid),
         cmocka_unit_test(unwritable_path_is_an_error_naming_it),

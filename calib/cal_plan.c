@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// The cost model of the plans (cal_plan.h).
+#include "cal_plan.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst)
+{
+    exp_drum_run_opts o = cal_drum_run_opts(d, rpm);
+    if (worst) return o.max_time;
+    return fmin(o.max_time, 2 * o.window + o.average_time);
+}
+
+double cal_plan_makespan(const double *task_s, int n, int parallel)
+{
+    double longest = 0, total = 0;
+    for (int i = 0; i < n; ++i) longest = fmax(longest, task_s[i]), total += task_s[i];
+    return fmax(longest, total / (parallel > 0 ? parallel : 1));
+}
+
+void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const double *rpm, int n, int m, int beds,
+                         int wall_stage, int bed_kept, int parallel, int worst)
+{
+    if (m <= 0 || n <= 0) return;
+    exp_drum_cost unit = exp_drum_predict_cost(&d->def, 1.0); // turning steps per simulated second
+    double fill_s = unit.fill_particle_steps / CAL_PLAN_RATE, turns_s = 0;
+    double *turn_s = calloc((size_t)n, sizeof *turn_s);
+    if (!turn_s) return;
+    for (int k = 0; k < n; ++k)
+        turn_s[k] = unit.turn_particle_steps * cal_plan_turn_time(d, rpm[k], worst) / CAL_PLAN_RATE, turns_s += turn_s[k];
+    int tasks_per_bed = m * beds, shared_bed = tasks_per_bed == 1 || (wall_stage && beds == 1);
+    int n_tasks = shared_bed ? tasks_per_bed * n : tasks_per_bed;
+    double *task = calloc((size_t)n_tasks, sizeof *task);
+    if (!task) return free(turn_s);
+    for (int i = 0; i < n_tasks; ++i) task[i] = shared_bed ? turn_s[i % n] : fill_s + turns_s;
+    double serial_fill = shared_bed && !bed_kept ? fill_s : 0;
+    cost->runs += tasks_per_bed * n;
+    cost->core_s += serial_fill + (shared_bed ? tasks_per_bed * turns_s : tasks_per_bed * (fill_s + turns_s));
+    cost->wall_s += serial_fill + cal_plan_makespan(task, n_tasks, parallel);
+    cost->memory_mb = fmax(cost->memory_mb, unit.memory_mb);
+    free(task), free(turn_s);
+}
+
+void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t len)
+{
+    snprintf(out, len, "%.2g core-hours, %.2g h on %d worker(s)", c->core_s / 3600, c->wall_s / 3600, parallel);
+}
