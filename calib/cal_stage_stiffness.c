@@ -79,7 +79,7 @@ int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, ca
     cal_record *rec = calloc((size_t)(n * seeds), sizeof *rec);
     if (!cases || !rec) return free(cases), free(rec), exp_fail(err, len, "out of memory");
     out->n = n;
-    out->scene = cal_tier_stiffness_on_drum(t) ? "the drum's poured bed" : "poured cylinder";
+    out->scene = cal_tier_stiffness_on_drum(t) ? "drum's own poured bed" : "poured cylinder";
     for (int i = 0; i < n; ++i) {
         out->k[i] = stiffness[i];
         for (int j = 0; j < seeds; ++j)

@@ -16,7 +16,7 @@ enum { CAL_MAX_K = 64, CAL_MAX_EVALS = 512, CAL_MAX_RPM = 16 };
 
 typedef struct cal_stiffness_result {
     int n;                       ///< stiffness candidates
-    const char *scene;           ///< the bed swept: "poured cylinder" or "the drum's poured bed"
+    const char *scene;           ///< the bed swept, read after "the": "poured cylinder" or "drum's own poured bed"
     double k[CAL_MAX_K];
     double cn_mean[CAL_MAX_K], cn_sd[CAL_MAX_K]; ///< over seeds
     double wall_cn[CAL_MAX_K], solid_fraction[CAL_MAX_K];

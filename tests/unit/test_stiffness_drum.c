@@ -99,7 +99,7 @@ static void test_drum_bed_recorded_resumed_chosen(void **state)
     cal_stiffness_result s;
     stage_one(&env, store, c, &s);
     assert_int_equal(env.simulations_run, N_K * t->seeds);
-    assert_string_equal(s.scene, "the drum's poured bed");
+    assert_string_equal(s.scene, "drum's own poured bed");
     for (int i = 0; i < N_K; ++i) {
         printf("k_n %g N/m: CN %.4f ± %.4f, %d granules, solid fraction %.3f\n", s.k[i], s.cn_mean[i], s.cn_sd[i],
                s.granules[i], s.solid_fraction[i]);
