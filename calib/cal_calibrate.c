@@ -251,8 +251,25 @@ static void data_path(const run *r, const char *name, const char *configured, ch
     else cal_config_data_path(r->c, configured, out, len);
 }
 
+// A measured size table (gsd_table) is kept beside the config's copy under
+// its own name, which the copy then finds (a path relative to the config);
+// a table named with folders is not, and the run says so.
+static int keep_size_table(run *r)
+{
+    if (!r->c->gsd_table) return 0;
+    if (strchr(r->c->gsd_table, '/')) {
+        fprintf(stderr, "granucal calibrate: the size table '%s' is not kept in %s (its name has folders): a "
+                        "re-derivation from that folder needs it there\n", r->c->gsd_table, r->out);
+        return 0;
+    }
+    char from[1200], to[1200];
+    cal_config_data_path(r->c, r->c->gsd_table, from, sizeof from);
+    snprintf(to, sizeof to, "%s/%s", r->out, r->c->gsd_table);
+    return cal_copy_file(from, to, r->err, sizeof r->err);
+}
+
 // The inputs this run read, copied into its results folder (config.yaml,
-// repose_angle.csv, occupied_area.csv): its table can be re-derived from the
+// repose_angle.csv, occupied_area.csv, a size table): its table can be re-derived from the
 // folder alone (tests/calibration/verify_committed.sh) whatever the shipped
 // config and data become.
 static int keep_inputs(run *r)
@@ -266,7 +283,7 @@ static int keep_inputs(run *r)
         snprintf(to, sizeof to, "%s/%s", r->out, names[k]);
         if (cal_copy_file(from, to, r->err, sizeof r->err)) return 1;
     }
-    return 0;
+    return keep_size_table(r);
 }
 
 // Everything checked, the plan predicted, then the results folder made: a
