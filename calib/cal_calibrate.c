@@ -607,11 +607,6 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
     return 0;
 }
 
-static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
-{
-    to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
-}
-
 // A step of the plan: its name and what it runs, expected and worst (w = 0, 1).
 static cal_plan *plan_step(plan *p, const char *name, const char *what)
 {
@@ -654,7 +649,7 @@ static int plan_cost(run *r, plan *p)
         if ((!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) && plan_friction_steps(r, p, pass, m, m->name))
             return 1;
     }
-    for (int k = 0; k < p->n; ++k) add_cost(&p->total.expected, &p->step[k].expected), add_cost(&p->total.worst, &p->step[k].worst);
+    for (int k = 0; k < p->n; ++k) cal_plan_add(&p->total, &p->step[k]);
     return 0;
 }
 
