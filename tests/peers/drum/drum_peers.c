@@ -148,7 +148,35 @@ typedef struct frame {
     double *x, *y, *r;
 } frame;
 
-// One frame of a dump custom file with columns id x y z radius; 0 at its end.
+// The columns of x, y and radius in a dump's "ITEM: ATOMS ..." line; 0, or 1
+// when one is missing.
+static int atom_columns(const char *line, int col[3])
+{
+    static const char *const names[3] = {"x", "y", "radius"};
+    col[0] = col[1] = col[2] = -1;
+    char copy[512], *save = NULL;
+    snprintf(copy, sizeof copy, "%s", line + strlen("ITEM: ATOMS"));
+    int i = 0;
+    for (char *w = strtok_r(copy, " \t\r\n", &save); w; w = strtok_r(NULL, " \t\r\n", &save), ++i)
+        for (int k = 0; k < 3; ++k)
+            if (strcmp(w, names[k]) == 0) col[k] = i;
+    return col[0] < 0 || col[1] < 0 || col[2] < 0;
+}
+
+// One value per column of a dump line into v (at most n); how many.
+static int split_values(char *line, double *v, int n)
+{
+    int m = 0;
+    for (char *p = line, *end; m < n; p = end) {
+        v[m] = strtod(p, &end);
+        if (end == p) break;
+        m++;
+    }
+    return m;
+}
+
+// One frame of a `dump custom` file with x, y and radius among its columns
+// (any order); 0 at its end or on a malformed frame.
 static int read_frame(FILE *f, frame *fr)
 {
     char line[512];
@@ -160,7 +188,9 @@ static int read_frame(FILE *f, frame *fr)
             break;
         }
     if (n == 0) return 0;
+    int col[3];
     while (fgets(line, sizeof line, f) && strncmp(line, "ITEM: ATOMS", 11) != 0) continue;
+    if (atom_columns(line, col)) return fprintf(stderr, "drum_peers: the dump has no x, y or radius column\n"), 0;
     if (n > fr->cap) {
         fr->cap = n;
         fr->x = realloc(fr->x, n * sizeof *fr->x), fr->y = realloc(fr->y, n * sizeof *fr->y);
@@ -168,8 +198,10 @@ static int read_frame(FILE *f, frame *fr)
         if (!fr->x || !fr->y || !fr->r) return 0;
     }
     for (fr->n = 0; fr->n < n && fgets(line, sizeof line, f); ++fr->n) {
-        double id, z;
-        if (sscanf(line, "%lf %lf %lf %lf %lf", &id, &fr->x[fr->n], &fr->y[fr->n], &z, &fr->r[fr->n]) != 5) return 0;
+        double v[32];
+        int m = split_values(line, v, 32);
+        if (m <= col[0] || m <= col[1] || m <= col[2]) return 0;
+        fr->x[fr->n] = v[col[0]], fr->y[fr->n] = v[col[1]], fr->r[fr->n] = v[col[2]];
     }
     return fr->n == n;
 }
@@ -211,9 +243,9 @@ static int cmd_measure(int argc, char **argv)
     }
     fclose(f);
     free(fr.x), free(fr.y), free(fr.r);
-    if (n < 2) return fprintf(stderr, "drum_peers: %s: %d frames measured\n", argv[3], n), 2;
-    double ma = s[0] / n, mc = s[1] / n;
-    double sa = sqrt(fmax(0, (q[0] - n * ma * ma) / (n - 1))), sc = sqrt(fmax(0, (q[1] - n * mc * mc) / (n - 1)));
+    if (n < 1) return fprintf(stderr, "drum_peers: %s: no frame measured\n", argv[3]), 2;
+    double ma = s[0] / n, mc = s[1] / n, dof = n > 1 ? n - 1 : 1; // one frame: no spread
+    double sa = sqrt(fmax(0, (q[0] - n * ma * ma) / dof)), sc = sqrt(fmax(0, (q[1] - n * mc * mc) / dof));
     printf("frames=%d\nunmeasured=%d\nangle=%.3f\nangle_sd=%.3f\ncsa=%.3f\ncsa_sd=%.3f\nangle_signed=%.3f\n", n, failed,
            ma, sa, mc, sc, s[2] / n);
     return 0;
