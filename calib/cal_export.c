@@ -189,6 +189,11 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
 
 enum { DECK_BINS = 8 };
 
+static void deck_path(char *out, size_t len, const char *dir, const char *code)
+{
+    snprintf(out, len, "%s/%s_drum.in", dir, code);
+}
+
 // The solid fraction a pass of LIGGGHTS' random insertion fills the space
 // above the bed to: well below where random insertion jams (about 0.38 for
 // equal spheres, less in a slice a few granules deep).
@@ -327,12 +332,13 @@ static void deck_step_text(FILE *f, const deck_scene *s)
 // How the deck makes the bed and turns it.
 static void deck_steps_text(FILE *f, const char *pour)
 {
-    fprintf(f, "# What it does: pours %s, in passes of pour_pass s, until the bed's top\n# stands a largest "
-               "diameter above the fill level; settles settle s; removes the granules whose centres lie above\n# the fill "
-               "level, where the drum's cross-section below holds the fill degree (granucal cuts where\n# the bed's "
-               "measured CSA is the fill degree, which a deck cannot measure); settles settle s; turns at rpm for spinup s; then dumps every sample s for\n# measure s (id "
-               "type x y z vx vy vz radius: the face's angle and CSA are measured from x, y, radius).\n# bed.dump holds "
-               "the settled bed before it turns.\n",
+    fprintf(f, "# What it does: pours %s,\n"
+               "# in passes of pour_pass s, until the bed's top stands a largest diameter above the fill level (the level\n"
+               "# below which the drum's cross-section holds the fill degree); settles settle s; removes the granules whose\n"
+               "# centres lie above the fill level (granucal cuts where the bed's measured CSA is the fill degree, which a\n"
+               "# deck cannot measure); settles settle s; turns at rpm for spinup s; then dumps every sample s for measure s\n"
+               "# (id type x y z vx vy vz radius: the face's angle and CSA are measured from x, y and radius). bed.dump\n"
+               "# holds the settled bed before it turns.\n",
             pour);
 }
 
@@ -460,7 +466,7 @@ static void deck_pass_end(FILE *f, const char *after)
 static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
 {
     char path[1200];
-    snprintf(path, sizeof path, "%s/liggghts_drum.in", dir);
+    deck_path(path, sizeof path, dir, "liggghts");
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
@@ -500,7 +506,8 @@ static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck
 // at its number fraction to within a granule or two.
 static void lammps_pour(FILE *f, const deck_scene *s)
 {
-    fputs("\n# The pour: lattice sites one largest diameter apart above the bed, in passes, each landing before the next.\n"
+    fputs("\n# The pour, as granucal's: lattice sites one largest diameter apart above the bed, each granule with a small\n"
+          "# sideways velocity (without it they land in columns), in passes.\n"
           "variable pitch equal 1.05*v_dmax\nlattice sc ${pitch} origin 0.5 0.5 0.5\n"
           "region inner cylinder z 0. 0. $(v_rdrum-0.55*v_pitch) $(0.5*v_pitch-1e-9) $(v_depth-0.5*v_pitch+1e-9) units box\n"
           "variable u atom 0.6180339887498949*id-floor(0.6180339887498949*id)\n", f);
@@ -530,7 +537,7 @@ static void lammps_walls(FILE *f, const deck_scene *s, const char *name, const c
 static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
 {
     char path[1200];
-    snprintf(path, sizeof path, "%s/lammps_drum.in", dir);
+    deck_path(path, sizeof path, dir, "lammps");
     cal_atomic_file a;
     if (cal_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
@@ -564,10 +571,16 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     return cal_atomic_commit(&a, err, len);
 }
 
-// The decks need a wall material to line the drum with.
+// The decks need a wall material to line the drum with: without one (the
+// wall stage did not run) there are none, and an earlier run's are removed.
 static int write_decks(const char *dir, const cal_outcome *o, char *err, size_t len)
 {
-    if (o->table.n_walls == 0) return 0;
+    if (o->table.n_walls == 0) {
+        char path[1200];
+        deck_path(path, sizeof path, dir, "liggghts"), remove(path);
+        deck_path(path, sizeof path, dir, "lammps"), remove(path);
+        return 0;
+    }
     deck_scene s;
     return scene_of(o, &s, err, len) || write_liggghts_deck(dir, o, &s, err, len) ||
            write_lammps_deck(dir, o, &s, err, len);
@@ -578,8 +591,9 @@ int cal_export_write(const char *dir, const cal_outcome *o, char *err, size_t le
     return write_liggghts(dir, o, err, len) || write_lammps(dir, o, err, len) || write_decks(dir, o, err, len);
 }
 
-// The exported tables: what they leave out, and the peers check of DIR/peers
-// when one was run on this table (tests/peers/drum_peers.sh writes its summary.txt).
+// The exports: what the parameter files leave out, the decks, and the peers
+// check of DIR/peers when one was run on them (tests/peers/drum_peers.sh
+// writes its summary.txt).
 void cal_export_report(FILE *f, const char *dir)
 {
     fputs("\n## The table in LIGGGHTS and LAMMPS\n\n`liggghts_parameters.in` (LIGGGHTS 3.8) leaves out of the paper's "
@@ -588,16 +602,28 @@ void cal_export_report(FILE *f, const char *dir)
     fputs("\n`lammps_parameters.in` (LAMMPS `pair_style granular`):\n\n", f);
     write_differences(f, lammps_differences, "- ", "  ");
     char path[1200], line[512];
+    deck_path(path, sizeof path, dir, "liggghts");
+    FILE *deck = fopen(path, "r");
+    if (!deck) {
+        fputs("\nNo complete decks: the table has no wall material to line the drum with (the wall stage did not "
+              "run).\n", f);
+        return;
+    }
+    fclose(deck);
+    fputs("\n`liggghts_drum.in` and `lammps_drum.in` are complete decks of the calibration's drum at its tier (its "
+          "geometry, the GSD at lambda, granucal's time step and why, the pour, the cut to the fill degree, the turn, "
+          "dumps): run them as written in this folder (`liggghts -in liggghts_drum.in`, `lmp -in lammps_drum.in`); "
+          "`-var NAME VALUE` sets lambda, rpm, lining, spinup, measure and the rest their headers list.\n", f);
     snprintf(path, sizeof path, "%s/peers/summary.txt", dir);
     FILE *s = fopen(path, "r");
     if (!s) {
-        fprintf(f, "\nNo peers check was run on this table. `TABLE=%s/calibrated_parameters.csv bash "
-                   "tests/peers/drum_peers.sh build/granucal build/tests/drum_peers %s/peers` runs both files as "
-                   "written on the ci drum slice beside granucal and measures them alike; the report then shows its "
-                   "numbers. At the ci table: `results/peers/README.md`.\n", dir, dir);
+        fprintf(f, "\nNo peers check was run on these decks. For a ci-tier calibration, `CALIBRATION=%s bash "
+                   "tests/peers/drum_peers.sh build/granucal build/tests/drum_peers %s/peers` runs both as written "
+                   "beside granucal on the same drum and measures them alike; the report then shows its numbers. "
+                   "At the committed ci twin: `results/peers/README.md`.\n", dir, dir);
         return;
     }
-    fputs("\nThe peers check run on this table (`tests/peers/drum_peers.sh`, its `peers/summary.txt`):\n\n```\n", f);
+    fputs("\nThe peers check run on these decks (`tests/peers/drum_peers.sh`, its `peers/summary.txt`):\n\n```\n", f);
     while (fgets(line, sizeof line, s)) fputs(line, f);
     fputs("```\n", f);
     fclose(s);
