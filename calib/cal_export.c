@@ -452,15 +452,16 @@ static void liggghts_walls(FILE *f, const deck_scene *s, const char *shear)
 // The pour's passes: each (written between these two) places granules above
 // the bed and lets them land, until the bed's top stands a largest diameter
 // above the cut (at most 50 passes): the bed reaches the cut also where its
-// surface dips. `after` ends the pass.
+// surface dips. `after` ends the pass; the next pass places granules above
+// `floor` (the highest centre plus `clearance`).
 static void deck_pass_begin(FILE *f) { fputs("variable pass loop 50\nlabel pour\n", f); }
 
-static void deck_pass_end(FILE *f, const char *after)
+static void deck_pass_end(FILE *f, const char *after, const char *clearance)
 {
-    fprintf(f, "run $(floor(v_pour_pass/v_dt+0.5))\n%svariable floor string $(bound(all,ymax)+v_pitch)\n"
+    fprintf(f, "run $(floor(v_pour_pass/v_dt+0.5))\n%svariable floor string $(bound(all,ymax)%s)\n"
                "if \"$(bound(all,ymax)) >= $(v_cut+v_dmax)\" then \"jump SELF poured\"\nnext pass\njump SELF pour\n"
                "label poured\nprint \"granucal deck: $(count(all)) granules poured\"\n",
-            after);
+            after, clearance);
 }
 
 static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
@@ -487,7 +488,7 @@ static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck
     deck_thermo(f);
     deck_pass_begin(f);
     liggghts_pass(f, s);
-    deck_pass_end(f, "unfix ins\n");
+    deck_pass_end(f, "unfix ins\n", ""); // insert/pack checks overlaps itself
     deck_cut_and_dump(f);
     fputs("\n# The turn: in LIGGGHTS 3.8 a zcylinder's `shear x W` turns it about its axis at W rad/s, counter-clockwise\n"
           "# seen from +z (`shear z` would slide it along the axis).\nunfix drum\n", f);
@@ -561,7 +562,7 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     deck_thermo(f);
     deck_pass_begin(f);
     fputs(lammps_pass, f);
-    deck_pass_end(f, "");
+    deck_pass_end(f, "", "+v_pitch"); // a lattice site a pitch above every centre overlaps none
     deck_cut_and_dump(f);
     fputs("\n# The turn: the region turns about z at omega rad/s (the wall takes its surface velocity from it).\n"
           "unfix drum\nvariable theta equal v_omega*(time-$(time))\n", f);
