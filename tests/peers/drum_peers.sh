@@ -101,7 +101,7 @@ for seed in 1 2 3; do
   echo "$seed,$(json granucal_s$seed.json angle_deg),$(json granucal_s$seed.json csa_percent),$(json granucal_s$seed.json granules)" >> granucal.csv
 done
 read -r g_angle g_angle_sd g_csa g_csa_sd < <(awk -F, '{a += $2; aa += $2 * $2; c += $3; cc += $3 * $3; n++}
-  END {printf "%.3f %.3f %.3f %.3f\n", a / n, sqrt((aa - a * a / n) / (n - 1)), c / n, sqrt((cc - c * c / n) / (n - 1)))}' granucal.csv)
+  END {printf "%.3f %.3f %.3f %.3f\n", a / n, sqrt((aa - a * a / n) / (n - 1)), c / n, sqrt((cc - c * c / n) / (n - 1))}' granucal.csv)
 
 # 5. Measure and compare.
 for peer in liggghts lammps; do
