@@ -210,7 +210,7 @@ typedef struct deck_scene {
     int n_rpm;
     int bins;                                 // the GSD in classes (gsd_bins), real diameters
     double bin_d[DECK_BINS], bin_p[DECK_BINS];
-    double dt_crit, dt, dt_limit;             // s, at the tier's lambda (granucal_step)
+    double dt_crit, dt;                       // s, at the tier's lambda (granucal_step)
     char dt_report[400];                      // the engine's own account of its step
     double level;                             // m above the axis: the fill level
 } deck_scene;
@@ -254,7 +254,7 @@ static int granucal_step(deck_scene *s, char *err, size_t len)
                                     0.5 * dem_gsd_min_diameter(&gsd), dem_scale_density(d->density, d->lambda)) < 0 ||
               dem_world_prepare(w) != DEM_OK;
     if (bad) snprintf(err, len, "export: the drum's time step: %s", dem_world_error(w));
-    s->dt = dem_world_dt(w), s->dt_limit = dem_world_dt_limit(w);
+    s->dt = dem_world_dt(w);
     snprintf(s->dt_report, sizeof s->dt_report, "%s", dem_world_dt_report(w));
     dem_world_destroy(w);
     s->dt_crit = exp_lightest_dt_crit(&d->gsd, d->density, d->granule.k_n, d->lambda);
@@ -422,19 +422,20 @@ static void liggghts_pour(FILE *f, const deck_scene *s)
                    "$(%.6g*v_cg)\n", k + 1, seed, 0.5 * s->bin_d[k]);
     fprintf(f, "fix pdd all particledistribution/discrete/numberbased %ld %d", seed, s->bins);
     for (int k = 0; k < s->bins; ++k) fprintf(f, " pts%d %.6g", k + 1, s->bin_p[k]);
-    fprintf(f, "\nvariable pitch equal 1.05*v_dmax\n"
+    fprintf(f, "\nvariable pour_seed index %ld   # a prime above 10000: the pour's random places (another, another bed)\n",
+            prime_above(20000 + 1000 * (long)(s->drum.seed % 1000000)));
+    fprintf(f, "variable pitch equal 1.05*v_dmax\n"
                "region inner cylinder z 0. 0. $(v_rdrum-0.55*v_pitch) 0. ${depth} units box\n"
                "variable floor string $(-v_rdrum)\n");
 }
 
-static void liggghts_pass(FILE *f, const deck_scene *s)
+static void liggghts_pass(FILE *f)
 {
-    long seed = prime_above(20000 + 1000 * (long)(s->drum.seed % 1000000));
     fprintf(f, "region above${pass} block $(-v_rdrum) ${rdrum} ${floor} ${rdrum} 0. ${depth} units box\n"
                "region sites${pass} intersect 2 inner above${pass}\n"
-               "fix ins all insert/pack seed %ld distributiontemplate pdd maxattempt 200 insert_every once "
+               "fix ins all insert/pack seed ${pour_seed} distributiontemplate pdd maxattempt 200 insert_every once "
                "overlapcheck yes all_in yes vel constant 0. 0. 0. volumefraction_region %g region sites${pass} "
-               "ntry_mc 10000\n", seed, DECK_PASS_FRACTION);
+               "ntry_mc 10000\n", DECK_PASS_FRACTION);
 }
 
 // The drum wall (and a full drum's end plates, which LIGGGHTS' primitive
@@ -487,7 +488,7 @@ static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck
     fputs("fix integr all nve/sphere\n", f);
     deck_thermo(f);
     deck_pass_begin(f);
-    liggghts_pass(f, s);
+    liggghts_pass(f);
     deck_pass_end(f, "unfix ins\n", ""); // insert/pack checks overlaps itself
     deck_cut_and_dump(f);
     fputs("\n# The turn: in LIGGGHTS 3.8 a zcylinder's `shear x W` turns it about its axis at W rad/s, counter-clockwise\n"
