@@ -35,7 +35,12 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 G=$(realpath "$1") DP=$(realpath "$2")
 out=$(mkdir -p "$3" && realpath "$3")
-for exe in liggghts lmp; do
+# PEERS: which peers to run and judge (default both): ctest runs each as its own test, so that one
+# peer's verdict does not hide the other's (tests/CMakeLists.txt).
+PEERS=${PEERS:-liggghts lammps}
+exe_of() { [ "$1" = lammps ] && echo lmp || echo "$1"; }
+for peer in $PEERS; do
+  exe=$(exe_of $peer)
   command -v $exe >/dev/null || { echo "SKIP: $exe not installed (apt-get install -y liggghts lammps)"; exit 77; }
 done
 COMMITTED=$root/results/twin_ci/r4_ci_test
@@ -88,10 +93,13 @@ run_peer() { # CODE EXE DECK
   rm -rf "$1" && mkdir "$1" && cp "$export_dir"/*.in "$1/"
   (cd "$1" && { time nice $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" -log $1.log > $1.out 2>&1; } 2> $1.time)
 }
-run_peer liggghts liggghts liggghts_drum.in & lig=$!
-run_peer lammps lmp lammps_drum.in & lmp=$!
-wait $lig || fail "liggghts_drum.in did not run: $(tail -3 liggghts/liggghts.out)"
-wait $lmp || fail "lammps_drum.in did not run: $(tail -3 lammps/lammps.out)"
+declare -A pid
+for peer in $PEERS; do
+  run_peer $peer $(exe_of $peer) ${peer}_drum.in & pid[$peer]=$!
+done
+for peer in $PEERS; do
+  wait ${pid[$peer]} || fail "${peer}_drum.in did not run: $(tail -3 $peer/$peer.out)"
+done
 
 # 4. granucal, three seeds.
 json() { grep -o "\"$2\": [-0-9.eE+]*" "$1" | head -1 | awk '{print $2}'; }
@@ -104,7 +112,7 @@ read -r g_angle g_angle_sd g_csa g_csa_sd < <(awk -F, '{a += $2; aa += $2 * $2; 
   END {printf "%.3f %.3f %.3f %.3f\n", a / n, sqrt((aa - a * a / n) / (n - 1)), c / n, sqrt((cc - c * c / n) / (n - 1))}' granucal.csv)
 
 # 5. Measure and compare.
-for peer in liggghts lammps; do
+for peer in $PEERS; do
   "$DP" measure drum.yaml $peer/${peer}_drum.dump "${sets[@]}" > $peer.measure
   "$DP" measure drum.yaml $peer/bed.dump "${sets[@]}" > $peer.bed
 done
@@ -117,7 +125,7 @@ tol_c=$(awk -v s="$g_csa_sd" -v f=$SD_FLOOR_CSA 'BEGIN {printf "%.3f", 3 * (s > 
   printf '%-10s %6.2f sd %5.2f (seeds) %6.2f sd %5.2f (seeds) %s\n' granucal "$g_angle" "$g_angle_sd" "$g_csa" "$g_csa_sd" \
     "3 seeds (seed,angle,CSA,granules): $(tr '\n' ' ' < granucal.csv)"
   fails=0
-  for peer in liggghts lammps; do
+  for peer in $PEERS; do
     (. ./$peer.measure
      da=$(awk -v p="$angle" -v g="$g_angle" 'BEGIN {printf "%.2f", p - g}')
      dc=$(awk -v p="$csa" -v g="$g_csa" 'BEGIN {printf "%.2f", p - g}')
