@@ -94,10 +94,16 @@ static const char help[] =
     "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
     "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
     "\n"
-    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max),\n"
-    "simulations.csv, report.md (every candidate, its chi^2, the ranges),\n"
-    "cn_vs_k.png, angle_map_*.png, csa_vs_rpm_*.png, convergence_*.png,\n"
-    "liggghts_parameters.in, lammps_parameters.in.\n";
+    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max,\n"
+    "not_excluded_min/max, status and flags: calibrated, one-sided at a search bound,\n"
+    "not identified, not a result; the run's tier, lambda, data and purpose on every\n"
+    "row; the posterior's median and 95 % credible interval), simulations.csv,\n"
+    "report.md (every candidate, its chi^2, the ranges, the posterior, which\n"
+    "measurement moves with which friction), cn_vs_k.png, angle_map_*.png,\n"
+    "csa_vs_rpm_*.png, convergence_*.png, posterior_*.png, liggghts_parameters.in,\n"
+    "lammps_parameters.in, and complete decks of the drum: liggghts_drum.in,\n"
+    "lammps_drum.in. A tier marked `purpose: demonstration` (quick, ci, check) makes\n"
+    "a demonstration, never a calibration, and every output says so.\n";
 
 typedef struct options {
     const char *config, *tier, *stage, *material, *out, *data;
