@@ -94,10 +94,16 @@ static const char help[] =
     "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
     "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
     "\n"
-    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max),\n"
-    "simulations.csv, report.md (every candidate, its chi^2, the ranges),\n"
-    "cn_vs_k.png, angle_map_*.png, csa_vs_rpm_*.png, convergence_*.png,\n"
-    "liggghts_parameters.in, lammps_parameters.in.\n";
+    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max,\n"
+    "not_excluded_min/max, status and flags: calibrated, one-sided at a search bound,\n"
+    "not identified, not a result; the run's tier, lambda, data and purpose on every\n"
+    "row; the posterior's median and 95 % credible interval), simulations.csv,\n"
+    "report.md (every candidate, its chi^2, the ranges, the posterior, which\n"
+    "measurement moves with which friction), cn_vs_k.png, angle_map_*.png,\n"
+    "csa_vs_rpm_*.png, convergence_*.png, posterior_*.png, liggghts_parameters.in,\n"
+    "lammps_parameters.in, and complete decks of the drum: liggghts_drum.in,\n"
+    "lammps_drum.in. A tier marked `purpose: demonstration` (quick, ci, check) makes\n"
+    "a demonstration, never a calibration, and every output says so.\n";
 
 typedef struct options {
     const char *config, *tier, *stage, *material, *out, *data;
@@ -251,8 +257,25 @@ static void data_path(const run *r, const char *name, const char *configured, ch
     else cal_config_data_path(r->c, configured, out, len);
 }
 
+// A measured size table (gsd_table) is kept beside the config's copy under
+// its own name, which the copy then finds (a path relative to the config);
+// a table named with folders is not, and the run says so.
+static int keep_size_table(run *r)
+{
+    if (!r->c->gsd_table) return 0;
+    if (strchr(r->c->gsd_table, '/')) {
+        fprintf(stderr, "granucal calibrate: the size table '%s' is not kept in %s (its name has folders): a "
+                        "re-derivation from that folder needs it there\n", r->c->gsd_table, r->out);
+        return 0;
+    }
+    char from[1200], to[1200];
+    cal_config_data_path(r->c, r->c->gsd_table, from, sizeof from);
+    snprintf(to, sizeof to, "%s/%s", r->out, r->c->gsd_table);
+    return cal_copy_file(from, to, r->err, sizeof r->err);
+}
+
 // The inputs this run read, copied into its results folder (config.yaml,
-// repose_angle.csv, occupied_area.csv): its table can be re-derived from the
+// repose_angle.csv, occupied_area.csv, a size table): its table can be re-derived from the
 // folder alone (tests/calibration/verify_committed.sh) whatever the shipped
 // config and data become.
 static int keep_inputs(run *r)
@@ -266,7 +289,7 @@ static int keep_inputs(run *r)
         snprintf(to, sizeof to, "%s/%s", r->out, names[k]);
         if (cal_copy_file(from, to, r->err, sizeof r->err)) return 1;
     }
-    return 0;
+    return keep_size_table(r);
 }
 
 // Everything checked, the plan predicted, then the results folder made: a
@@ -592,11 +615,6 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
     return 0;
 }
 
-static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
-{
-    to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
-}
-
 // A step of the plan: its name and what it runs, expected and worst (w = 0, 1).
 static cal_plan *plan_step(plan *p, const char *name, const char *what)
 {
@@ -639,7 +657,7 @@ static int plan_cost(run *r, plan *p)
         if ((!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) && plan_friction_steps(r, p, pass, m, m->name))
             return 1;
     }
-    for (int k = 0; k < p->n; ++k) add_cost(&p->total.expected, &p->step[k].expected), add_cost(&p->total.worst, &p->step[k].worst);
+    for (int k = 0; k < p->n; ++k) cal_plan_add(&p->total, &p->step[k]);
     return 0;
 }
 

@@ -92,7 +92,7 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
         mu_s[i] = r->cand[i].mu_s, mu_r[i] = r->cand[i].mu_r, angle[i] = r->cand[i].angle_deg,
         predicted[i] = r->cand[i].predicted;
     int mapped = map_candidates(r);
-    char path[1200], title[160], band[160], source[64], evaluated[96], mapped_label[160], chosen[96] = "";
+    char path[1200], title[160], band[160], source[64], evaluated[96], mapped_label[160], chosen[128] = "";
     snprintf(path, sizeof path, "%s/angle_map_%s.png", dir, stage_name(r));
     snprintf(title, sizeof title, "%s: dynamic angle of repose at %g rpm (Fig. %s)", stage_name(r), r->angle_rpm,
              r->material[0] ? "17" : "13");
@@ -105,7 +105,8 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
     snprintf(mapped_label, sizeof mapped_label, "map tier '%s' runs + measured correction (%d; predicted, not run here)",
              r->map_tier, mapped);
     if (r->best >= 0)
-        snprintf(chosen, sizeof chosen, "chosen: μs = %.3g, μr = %.3g", r->cand[r->best].mu_s, r->cand[r->best].mu_r);
+        snprintf(chosen, sizeof chosen, "the search's choice: μs = %.3g, μr = %.3g (its status: the table)",
+                 r->cand[r->best].mu_s, r->cand[r->best].mu_r);
     exp_plot_map m = {.title = title, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
                       .zlabel = mapped ? "angle (°), measured and predicted" : "angle (°)", .n = (size_t)r->n,
                       .x = mu_s, .y = mu_r, .z = angle,
@@ -176,7 +177,7 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
                                 .rgb = {black[0], black[1], black[2]},
                                 .label = r->angle_in_misfit ? "best so far" : "best matching the angle so far"};
     if (isfinite(d->chosen_index[0]))
-        s[ns++] = points(1, d->chosen_index, d->chosen_objective, "chosen", red, EXP_MARK_STAR);
+        s[ns++] = points(1, d->chosen_index, d->chosen_objective, "the search's choice", red, EXP_MARK_STAR);
     if (d->map_points)
         s[ns++] = points((size_t)d->map_points, d->map_index, d->mapped, map_label, grey, EXP_MARK_OPEN_DIAMOND);
     exp_plot_axes axes = {.title = title,
@@ -236,7 +237,7 @@ static int csa_vs_rpm(const char *dir, const cal_friction_result *r, char *err, 
     exp_plot_style style = n_rpm > 1 ? EXP_PLOT_LINE_POINTS : EXP_PLOT_POINTS;
     if (r->best >= 0) {
         const cal_candidate *k = &r->cand[r->best];
-        snprintf(labels[1], sizeof labels[1], "chosen: μs = %.3g, μr = %.3g (bars: seed sd)", k->mu_s, k->mu_r);
+        snprintf(labels[1], sizeof labels[1], "the search's choice: μs = %.3g, μr = %.3g (bars: seed sd)", k->mu_s, k->mu_r);
         s[ns++] = (exp_plot_series){.n = n_rpm, .x = r->rpm, .y = k->csa, .err = k->csa_sd, .label = labels[1],
                                     .rgb = {red[0], red[1], red[2]}, .style = style, .marker = EXP_MARK_STAR};
     }

@@ -47,3 +47,13 @@ void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t l
 {
     snprintf(out, len, "%.2g core-hours, %.2g h on %d worker(s)", c->core_s / 3600, c->wall_s / 3600, parallel);
 }
+
+static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
+{
+    to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
+}
+
+void cal_plan_add(cal_plan *total, const cal_plan *p)
+{
+    add_cost(&total->expected, &p->expected), add_cost(&total->worst, &p->worst);
+}

@@ -31,6 +31,10 @@ typedef struct cal_plan {
     cal_plan_cost expected, worst;
 } cal_plan;
 
+/// Add plan p to a total, expected and worst case alike (runs, seconds; the
+/// largest memory).
+void cal_plan_add(cal_plan *total, const cal_plan *p);
+
 /// Simulated seconds a drum run of case d turns at rpm: the worst case
 /// max_time; expected, the steady test's first chance (its two windows, then
 /// the averaging time), at most max_time. Every λ 1000 run of the committed

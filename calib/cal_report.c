@@ -574,8 +574,9 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
     if (ftell(f) == before) fputs("- none: every friction was chosen by the data.\n", f);
     fputc('\n', f);
     fputs("Files: `calibrated_parameters.{csv,md,h5}`, `simulations.csv` (every simulation, its cost and status), "
-          "plots `cn_vs_k.png`, `angle_map_*.png`, `csa_vs_rpm_*.png`, `convergence_*.png`, and "
-          "`liggghts_parameters.in`, `lammps_parameters.in`.\n", f);
+          "plots `cn_vs_k.png`, `angle_map_*.png`, `csa_vs_rpm_*.png`, `convergence_*.png`, `posterior_*.png`, "
+          "the table for LIGGGHTS and LAMMPS (`liggghts_parameters.in`, `lammps_parameters.in`) and complete decks "
+          "of the drum (`liggghts_drum.in`, `lammps_drum.in`, where a wall stage ran).\n", f);
     const cal_stiffness_result *s = o->stiffness;
     if (s) {
         fprintf(f, "\n## Stiffness (poured cylinder, pour friction μs = %g, μr = %g)\n\n| k_n (N/m) | CN mean | CN sd | "

@@ -289,9 +289,7 @@ static double print_plan(const study *s)
         fprintf(stderr, "   %-22s %4d drum runs %8.2f (%8.2f) core-hours %7.2f (%7.2f) h%s\n", rung->name, p.expected.runs,
                 p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600, p.worst.wall_s / 3600,
                 fits ? "" : "  over the budget left: not run");
-        total.expected.runs += fits ? p.expected.runs : 0;
-        total.expected.core_s += fits ? p.expected.core_s : 0, total.expected.wall_s += fits ? p.expected.wall_s : 0;
-        total.worst.core_s += fits ? p.worst.core_s : 0, total.worst.wall_s += fits ? p.worst.wall_s : 0;
+        if (fits) cal_plan_add(&total, &p);
     }
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);

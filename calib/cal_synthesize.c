@@ -369,9 +369,7 @@ static void print_plan(const job *j)
         fprintf(stderr, "   %-20s %4d drum runs %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", j->linings[l].surface,
                 p.expected.runs, p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600,
                 p.worst.wall_s / 3600);
-        total.expected.runs += p.expected.runs, total.expected.core_s += p.expected.core_s;
-        total.expected.wall_s += p.expected.wall_s, total.worst.core_s += p.worst.core_s, total.worst.wall_s += p.worst.wall_s;
-        total.expected.memory_mb = fmax(total.expected.memory_mb, p.expected.memory_mb);
+        cal_plan_add(&total, &p);
     }
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);

@@ -41,14 +41,18 @@ dem_gsd dem_gsd_lognormal(double median_diameter, double geometric_sd, double tr
                      .truncation_sigmas = truncation_sigmas};
 }
 
+static int vfail(char *msg, size_t len, const char *fmt, va_list ap)
+{
+    if (msg && len > 0) vsnprintf(msg, len, fmt, ap);
+    return 1;
+}
+
 static int fail(char *msg, size_t len, const char *fmt, ...)
 {
-    if (msg && len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, len, fmt, ap);
-        va_end(ap);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    vfail(msg, len, fmt, ap);
+    va_end(ap);
     return 1;
 }
 
@@ -303,12 +307,10 @@ static int table_fail(int *bad_row, int row, char *msg, size_t len, const char *
 static int table_fail(int *bad_row, int row, char *msg, size_t len, const char *fmt, ...)
 {
     if (bad_row) *bad_row = row;
-    if (msg && len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, len, fmt, ap);
-        va_end(ap);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    vfail(msg, len, fmt, ap);
+    va_end(ap);
     return 1;
 }
 

@@ -129,9 +129,7 @@ int exp_drum_fill_method_from_name(const char *name, exp_drum_fill_method *out)
 
 const char *exp_drum_fill_method_name(exp_drum_fill_method m) { return m == EXP_FILL_PACK ? "pack" : "pour"; }
 
-// Height (from the axis) below which the drum's cross-section holds the
-// fraction `fill` of its area: the level of a bed of that fill degree.
-static double fill_level(double r, double fill)
+double exp_drum_fill_level(double r, double fill)
 {
     double lo = -r, hi = r;
     for (int it = 0; it < 60; ++it) {
@@ -157,7 +155,7 @@ static size_t place_layer(dem_world *w, const exp_drum_def *d, const double *dia
     exp_pour_region region = {dem_v3(-inner, -r, margin), dem_v3(inner, inner, d->depth - margin + 1e-12), inside_drum,
                               &inner};
     if (d->fill_method == EXP_FILL_POUR) return exp_pour_layer(w, &region, -r, diam, next, n, pitch, density);
-    double level = fill_level(r, d->fill), surface = exp_bed_surface(w, -r);
+    double level = exp_drum_fill_level(r, d->fill), surface = exp_bed_surface(w, -r);
     double top = fmin(level + PACK_BAND_FACTOR * fmax(level - surface, pitch), inner);
     return exp_pack_band(w, &region, -r, top, diam, next, n, density, d->seed * 1000003ULL + (unsigned long long)layer,
                          PACK_TRIES);

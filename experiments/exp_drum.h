@@ -78,6 +78,10 @@ typedef struct exp_drum_physics {
 /// the depth of the slice or of the drum; the rest (pixel, closing) default.
 exp_drum_def exp_drum_def_from_physics(const exp_drum_physics *p);
 
+/// Height (from the axis) below which a drum of radius r holds the fraction
+/// `fill` of its cross-section: the level of a bed of that fill degree.
+double exp_drum_fill_level(double r, double fill);
+
 /// Check a definition; a message names the field.
 int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);
 
