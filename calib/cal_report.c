@@ -363,15 +363,16 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
     const cal_stiffness_result *s = o->stiffness;
     for (int i = 0; s && i < s->n; ++i)
         for (int j = 0; j < o->tier->seeds; ++j) {
-            exp_cylinder_def cd = cal_cylinder_case_make(o->config, o->tier, s->k[i], (uint64_t)(o->config->seed + j));
+            cal_bed_case bed = cal_bed_case_make(o->config, o->tier, s->k[i], (uint64_t)(o->config->seed + j));
             char key[2048], hash[17], e2[256];
-            cal_cylinder_key(&cd, key, sizeof key);
+            cal_bed_key(&bed, key, sizeof key);
             cal_store_hash(key, hash);
             cal_record rec;
             if (cal_store_get(store, key, &rec, e2, sizeof e2) != 0) continue;
-            fprintf(a.f, "stiffness,%d,%s,cylinder,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,0,,%d,%.5f,%.1f\n", i + 1,
-                    hash, cd.granule.mu_s, cd.granule.mu_r, s->k[i], rec.status, rec.reason ? rec.reason : "",
-                    rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination, rec.peak_rss_mb);
+            fprintf(a.f, "stiffness,%d,%s,%s,%.6g,%.6g,%g,%s,\"%s\",,,,,1,%.4f,%.1f,0,,%d,%.5f,%.1f\n", i + 1, hash,
+                    bed.on_drum ? "drum_bed" : "cylinder", o->config->pour_mu_s, o->config->pour_mu_r, s->k[i], rec.status,
+                    rec.reason ? rec.reason : "", rec.simulated_time_s, rec.wall_time_s, rec.granules, rec.coordination,
+                    rec.peak_rss_mb);
             tally_add(tally, hash, TALLY_CYLINDER, &rec);
             cal_record_free(&rec);
         }
@@ -579,9 +580,9 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
           "of the drum (`liggghts_drum.in`, `lammps_drum.in`, where a wall stage ran).\n", f);
     const cal_stiffness_result *s = o->stiffness;
     if (s) {
-        fprintf(f, "\n## Stiffness (poured cylinder, pour friction μs = %g, μr = %g)\n\n| k_n (N/m) | CN mean | CN sd | "
+        fprintf(f, "\n## Stiffness (the %s, pour friction μs = %g, μr = %g)\n\n| k_n (N/m) | CN mean | CN sd | "
                    "wall contacts/granule | solid fraction | granules | failed seeds |\n|---|---|---|---|---|---|---|\n",
-                o->config->pour_mu_s, o->config->pour_mu_r);
+                s->scene ? s->scene : "poured cylinder", o->config->pour_mu_s, o->config->pour_mu_r);
         for (int i = 0; i < s->n; ++i)
             fprintf(f, "| %g | %.3f | %.3f | %.3f | %.3f | %d | %d |\n", s->k[i], s->cn_mean[i], s->cn_sd[i], s->wall_cn[i],
                     s->solid_fraction[i], s->granules[i], s->failed[i]);

@@ -107,8 +107,8 @@ static cal_table_row stiffness_row(const cal_outcome *o, const char *contact, co
     if (!t->k_calibrated) {
         if (own) r.verdict.status = CAL_VALUE_NOT_RUN;
         add_flag(&r.verdict, "stage_not_run");
-    } else if (o->tier->cylinder_lambda != o->tier->lambda)
-        add_flag(&r.verdict, "stiffness_at_cylinder_lambda");
+    } else if (!cal_tier_stiffness_on_drum(o->tier) && o->tier->cylinder_lambda != o->tier->lambda)
+        add_flag(&r.verdict, "stiffness_at_cylinder_lambda"); // a drum-bed sweep ran at the drum's own λ
     return r;
 }
 
@@ -143,6 +143,7 @@ cal_run_status cal_run_status_of(const cal_outcome *o)
                             .tier = o->tier->name,
                             .drum_lambda = o->tier->lambda,
                             .cylinder_lambda = o->tier->cylinder_lambda,
+                            .stiffness_on_drum = cal_tier_stiffness_on_drum(o->tier),
                             .angle_synthetic = o->angle_data_synthetic,
                             .csa_synthetic = o->csa_data_synthetic};
 }
@@ -161,8 +162,13 @@ void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix)
         fprintf(f, "%sDEMONSTRATION - not a calibration of this powder: tier '%s' is marked `purpose: demonstration` "
                    "(too coarse for its values to stand for the powder).\n", prefix, s->tier);
     else fprintf(f, "%sCALIBRATION at tier '%s'.\n", prefix, s->tier);
-    fprintf(f, "%sCoarse-grained (eq. 15-18): the drum ran at lambda = %g, the stiffness cylinder at lambda = %g; the "
-               "values are for simulations at lambda = %g.\n", prefix, s->drum_lambda, s->cylinder_lambda, s->drum_lambda);
+    if (s->stiffness_on_drum)
+        fprintf(f, "%sCoarse-grained (eq. 15-18): the drum and its stiffness sweep ran at lambda = %g; the values are "
+                   "for simulations at lambda = %g.\n", prefix, s->drum_lambda, s->drum_lambda);
+    else
+        fprintf(f, "%sCoarse-grained (eq. 15-18): the drum ran at lambda = %g, the stiffness cylinder at lambda = %g; "
+                   "the values are for simulations at lambda = %g.\n", prefix, s->drum_lambda, s->cylinder_lambda,
+                s->drum_lambda);
     fprintf(f, "%sData: repose angle %s, occupied area (CSA) %s.\n", prefix,
             s->angle_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab",
             s->csa_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab");

@@ -36,7 +36,7 @@ typedef struct cal_verdict {
                       ///< other end of the interval no candidate excludes (the value itself if none)
     char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, outside_identified,
                       ///< outside_not_excluded, not_identified, angle_not_matched, stage_not_run,
-                      ///< stiffness_at_cylinder_lambda
+                      ///< stiffness_at_cylinder_lambda (stage 1 swept a cylinder at another λ than the drum's)
 } cal_verdict;
 
 /// A friction's verdict from its identified range g (cal_range; NAN lo: the
@@ -73,6 +73,7 @@ typedef struct cal_run_status {
     int demonstration;                 ///< the tier's purpose is "demonstration"
     const char *tier;
     double drum_lambda, cylinder_lambda;
+    int stiffness_on_drum;             ///< stage 1 swept the drum's own bed (stiffness_scene: drum), at its λ
     int angle_synthetic, csa_synthetic; ///< the data files say SYNTHETIC
 } cal_run_status;
 
