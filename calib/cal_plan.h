@@ -31,6 +31,10 @@ typedef struct cal_plan {
     cal_plan_cost expected, worst;
 } cal_plan;
 
+/// What a drum run's expected and worst-case figures assume (cal_plan_turn_time), as a plan prints it.
+#define CAL_PLAN_RUN_ASSUMPTION \
+    "expected: each run ends at the steady test's first chance (two windows, then its averaging); worst case: max_time."
+
 /// Add plan p to a total, expected and worst case alike (runs, seconds; the
 /// largest memory).
 void cal_plan_add(cal_plan *total, const cal_plan *p);

@@ -294,8 +294,7 @@ static double print_plan(const study *s)
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     fprintf(stderr, "== plan: the rungs within the budget (%.3g h): %d drum runs, expected %s; worst case %s\n"
-                    "   expected: each run ends at the steady test's first chance (two windows, then its averaging); worst "
-                    "case: max_time. At %.2g particle-steps per core-second (this project's 2-core machine); records "
+                    "   " CAL_PLAN_RUN_ASSUMPTION " At %.2g particle-steps per core-second (this project's 2-core machine); records "
                     "already in the store are not subtracted.\n",
             budget_s / 3600, total.expected.runs, e, w, CAL_PLAN_RATE);
     return total.expected.wall_s;

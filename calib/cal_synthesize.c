@@ -374,8 +374,7 @@ static void print_plan(const job *j)
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     fprintf(stderr, "== plan: %d drum runs (%d lining(s) x %d seed(s) x %d speed(s)); expected %s; worst case %s; %.0f MB a "
-                    "simulation\n   expected: each run ends at the steady test's first chance (two windows, then its "
-                    "averaging); worst case: max_time. k_n %g N/m. At %.2g particle-steps per core-second (this project's "
+                    "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " k_n %g N/m. At %.2g particle-steps per core-second (this project's "
                     "2-core machine); records already in the store or --reuse are not subtracted.\n",
             total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb, j->k_n, CAL_PLAN_RATE);
 }
