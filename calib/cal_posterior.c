@@ -200,6 +200,13 @@ int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_
     return 0;
 }
 
+const char *cal_posterior_reach_text(const cal_posterior *p, int k)
+{
+    if (p->reaches_lower[k] && p->reaches_upper[k]) return " (both bounds)";
+    if (p->reaches_lower[k]) return " (to the lower bound)";
+    return p->reaches_upper[k] ? " (to the upper bound)" : "";
+}
+
 int cal_posterior_blind(const cal_posterior *p, int parameter)
 {
     for (int k = 0; k < p->n_y; ++k)

@@ -49,6 +49,11 @@ typedef struct cal_posterior {
 /// usable candidates). Deterministic: a fixed seed.
 int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_posterior *out, char *err, size_t len);
 
+/// Whether parameter k's interval reaches a search bound, as the report
+/// says it after the interval: " (both bounds)", " (to the lower bound)",
+/// " (to the upper bound)" or "".
+const char *cal_posterior_reach_text(const cal_posterior *p, int k);
+
 /// 1 if no measurement moves by one data spread across parameter p's search range (0: μs, 1: μr).
 int cal_posterior_blind(const cal_posterior *p, int parameter);
 

@@ -23,28 +23,32 @@
 // Each friction stage run now, its posterior (cal_posterior.h): [0] the
 // granule stage, [1 + w] wall w. ok 0: not run now (read from a stage file),
 // or no map to sample (why says so).
-typedef struct posteriors {
-    cal_posterior of[17];
-    int ok[17];
-    char why[17][200];
-} posteriors;
+// The friction stages of an outcome: [0] granule–granule, [1 + w] wall w
+// (cal_outcome.walls holds 16); a stage not run is NULL.
+enum { MAX_STAGES = 17 };
 
+static int n_stages(const cal_outcome *o) { return 1 + o->n_walls < MAX_STAGES ? 1 + o->n_walls : MAX_STAGES; }
 static const cal_friction_result *stage_of(const cal_outcome *o, int i) { return i == 0 ? o->granule : o->walls[i - 1]; }
+static const cal_bounds *stage_bounds(const cal_outcome *o, int i) { return i ? &o->config->wall : &o->config->granule; }
+
+typedef struct posteriors {
+    cal_posterior of[MAX_STAGES];
+    int ok[MAX_STAGES];
+    char why[MAX_STAGES][200];
+} posteriors;
 
 static void posteriors_sample(const cal_outcome *o, posteriors *p)
 {
     memset(p, 0, sizeof *p);
-    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+    for (int i = 0; i < n_stages(o); ++i) {
         const cal_friction_result *r = stage_of(o, i);
-        if (r)
-            p->ok[i] = !cal_posterior_sample(r, i ? &o->config->wall : &o->config->granule, &p->of[i], p->why[i],
-                                             sizeof p->why[i]);
+        if (r) p->ok[i] = !cal_posterior_sample(r, stage_bounds(o, i), &p->of[i], p->why[i], sizeof p->why[i]);
     }
 }
 
 static void posteriors_free(posteriors *p)
 {
-    for (int i = 0; i < 17; ++i) cal_posterior_free(&p->of[i]);
+    for (int i = 0; i < MAX_STAGES; ++i) cal_posterior_free(&p->of[i]);
 }
 
 // The posterior of a table row's friction, or NULL.
@@ -52,7 +56,7 @@ static const cal_posterior *row_posterior(const cal_outcome *o, const posteriors
 {
     *param = !strcmp(row->parameter, "mu_r");
     if (strcmp(row->parameter, "mu_s") && !*param) return NULL;
-    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+    for (int i = 0; i < n_stages(o); ++i) {
         const cal_friction_result *r = stage_of(o, i);
         if (r && p->ok[i] && !strcmp(r->material, row->material)) return &p->of[i];
     }
@@ -149,11 +153,7 @@ static const char *posterior_cell(char out[96], const md_table *t, const cal_tab
     int p;
     const cal_posterior *q = row_posterior(t->o, t->post, r, &p);
     if (!q) return out[0] = '\0', out;
-    snprintf(out, 96, "%.3g [%.3g – %.3g]%s", q->median[p], q->lo[p], q->hi[p],
-             q->reaches_lower[p] && q->reaches_upper[p] ? " (both bounds)"
-             : q->reaches_lower[p]                     ? " (to the lower bound)"
-             : q->reaches_upper[p]                     ? " (to the upper bound)"
-                                                       : "");
+    snprintf(out, 96, "%.3g [%.3g – %.3g]%s", q->median[p], q->lo[p], q->hi[p], cal_posterior_reach_text(q, p));
     return out;
 }
 
@@ -500,11 +500,7 @@ static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bo
     const char *names[2] = {"μs", "μr"};
     for (int k = 0; k < 2; ++k)
         fprintf(f, "| %s | %.3g | %.3g – %.3g%s | %.3g – %.3g (%.3g – %.3g) |\n", names[k], p->median[k], p->lo[k],
-                p->hi[k], p->reaches_lower[k] && p->reaches_upper[k] ? " (both bounds)"
-                          : p->reaches_lower[k]                      ? " (to the lower bound)"
-                          : p->reaches_upper[k]                      ? " (to the upper bound)"
-                                                                     : "",
-                g[k]->lo, g[k]->hi, g[k]->bracket_lo, g[k]->bracket_hi);
+                p->hi[k], cal_posterior_reach_text(p, k), g[k]->lo, g[k]->hi, g[k]->bracket_lo, g[k]->bracket_hi);
     fputs("\nWhat each measurement can tell (its change across each parameter's whole search range, the other at "
           "its posterior median, in the data's spreads; below 1 it cannot tell that parameter at all):\n\n"
           "| measurement | data spread | across μs | across μr |\n|---|---|---|---|\n", f);
@@ -529,10 +525,8 @@ static void cost_row(FILE *f, const char *stage, const char *tier, int candidate
 static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
 {
     fputs("\n## What it cost\n\n| stage | tier | candidates | simulations | core-hours |\n|---|---|---|---|---|\n", f);
-    const cal_friction_result *stages[17] = {o->granule};
-    for (int w = 0; w < o->n_walls && w < 16; ++w) stages[1 + w] = o->walls[w];
-    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
-        const cal_friction_result *r = stages[i];
+    for (int i = 0; i < n_stages(o); ++i) {
+        const cal_friction_result *r = stage_of(o, i);
         if (!r) continue;
         const char *name = r->material[0] ? r->material : "granule-granule";
         if (r->map_tier[0]) cost_row(f, name, r->map_tier, r->map_candidates, r->map_simulations, r->map_core_s);
@@ -599,11 +593,10 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
                        "cylinder λ 32768 the CN rose below 50 N/m, results/stiffness_low_k/).\n",
                     s->k[0], o->config->k_n);
     }
-    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i)
+    for (int i = 0; i < n_stages(o); ++i)
         if (stage_of(o, i)) {
-            const cal_bounds *b = i ? &o->config->wall : &o->config->granule;
-            report_friction(f, stage_of(o, i), b);
-            report_posterior(f, stage_of(o, i), b, post->ok[i] ? &post->of[i] : NULL, post->why[i]);
+            report_friction(f, stage_of(o, i), stage_bounds(o, i));
+            report_posterior(f, stage_of(o, i), stage_bounds(o, i), post->ok[i] ? &post->of[i] : NULL, post->why[i]);
         }
     report_cost(f, o, tally);
     cal_export_report(f, dir);
@@ -613,9 +606,9 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
 static int write_figures(const char *dir, const cal_outcome *o, const posteriors *post, char *err, size_t len)
 {
     if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
-    for (int i = 0; i < 1 + o->n_walls && i < 17; ++i) {
+    for (int i = 0; i < n_stages(o); ++i) {
         const cal_friction_result *r = stage_of(o, i);
-        const cal_bounds *b = i ? &o->config->wall : &o->config->granule;
+        const cal_bounds *b = stage_bounds(o, i);
         if (!r) continue;
         if (cal_figures_friction(dir, b, r, err, len)) return 1;
         if (post->ok[i] && cal_figure_posterior(dir, b, r, &post->of[i], err, len)) return 1;
