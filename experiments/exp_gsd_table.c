@@ -3,6 +3,7 @@
 // exp_gsd_table.h for the format.
 #include "exp_gsd_table.h"
 
+#include <csv.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -47,41 +48,76 @@ static int parse_number(const char *path, int line, const char *field, char *tex
     return 0;
 }
 
-// A data row "size,percent" into the reader.
-static int add_row(table_reader *r, int line, char *text, char *err, size_t len)
+// The fields of one line as libcsv splits it (quoting and all), at most
+// MAX_FIELDS kept; n counts them all.
+enum { MAX_FIELDS = 3, FIELD_CHARS = 64 };
+typedef struct line_fields {
+    int n;
+    char text[MAX_FIELDS][FIELD_CHARS];
+} line_fields;
+
+static void on_field(void *s, size_t len, void *data)
 {
-    char *comma = strchr(text, ',');
-    if (!comma || strchr(comma + 1, ','))
-        return exp_fail(err, len, "%s:%d: row: expected 2 fields (%s)", r->path, line, HEADER);
+    line_fields *l = data;
+    if (l->n < MAX_FIELDS) snprintf(l->text[l->n], FIELD_CHARS, "%.*s", (int)len, s ? (const char *)s : "");
+    l->n++;
+}
+
+static void on_row(int c, void *data) { (void)c, (void)data; }
+
+// One line's fields (one line is one row in this schema); 1 if libcsv finds it malformed.
+static int split_line(struct csv_parser *p, const char *line, line_fields *l)
+{
+    memset(l, 0, sizeof *l);
+    return csv_parse(p, line, strlen(line), on_field, on_row, l) != strlen(line) ||
+           csv_fini(p, on_field, on_row, l) != 0;
+}
+
+// A data row "size,percent" into the reader.
+static int add_row(table_reader *r, int line, line_fields *l, char *err, size_t len)
+{
+    if (l->n != 2) return exp_fail(err, len, "%s:%d: row: expected 2 fields (%s)", r->path, line, HEADER);
     if (r->rows == DEM_GSD_TABLE_MAX_ROWS)
         return exp_fail(err, len, "%s:%d: row: more than %d rows", r->path, line, DEM_GSD_TABLE_MAX_ROWS);
-    *comma = '\0';
-    double size_um, percent;
-    if (parse_number(r->path, line, "size_um", text, &size_um, err, len) ||
-        parse_number(r->path, line, "cumulative_percent", comma + 1, &percent, err, len))
+    double size_um = 0, percent = 0;
+    if (parse_number(r->path, line, "size_um", l->text[0], &size_um, err, len) ||
+        parse_number(r->path, line, "cumulative_percent", l->text[1], &percent, err, len))
         return 1;
     r->size_m[r->rows] = size_um * 1e-6, r->percent[r->rows] = percent, r->line_of[r->rows] = line;
     r->rows++;
     return 0;
 }
 
+static int is_header(line_fields *l)
+{
+    return l->n == 2 && !strcmp(trim(l->text[0]), "size_um") && !strcmp(trim(l->text[1]), "cumulative_percent");
+}
+
+// Line by line (so that every message names its line), comments and blank
+// lines skipped, each line split by libcsv.
 static int read_rows(FILE *f, table_reader *r, char *err, size_t len)
 {
     char text[256];
-    int line = 0, header_seen = 0;
-    while (fgets(text, sizeof text, f)) {
+    int line = 0, header_seen = 0, bad = 0;
+    struct csv_parser p;
+    csv_init(&p, CSV_STRICT | CSV_APPEND_NULL | CSV_STRICT_FINI);
+    while (!bad && fgets(text, sizeof text, f)) {
         line++;
         if (!strchr(text, '\n') && !feof(f))
-            return exp_fail(err, len, "%s:%d: row: longer than %zu characters", r->path, line, sizeof text - 2);
+            bad = exp_fail(err, len, "%s:%d: row: longer than %zu characters", r->path, line, sizeof text - 2);
         char *t = trim(text);
-        if (*t == '#' || *t == '\0') continue;
-        if (!header_seen) {
-            if (strcmp(t, HEADER) != 0) return exp_fail(err, len, "%s:%d: header: expected %s", r->path, line, HEADER);
-            header_seen = 1;
-        } else if (add_row(r, line, t, err, len)) return 1;
+        if (bad || *t == '#' || *t == '\0') continue;
+        line_fields l;
+        if (split_line(&p, t, &l))
+            bad = exp_fail(err, len, "%s:%d: row: malformed CSV (%s)", r->path, line, csv_strerror(csv_error(&p)));
+        else if (!header_seen) {
+            header_seen = is_header(&l);
+            if (!header_seen) bad = exp_fail(err, len, "%s:%d: header: expected %s", r->path, line, HEADER);
+        } else bad = add_row(r, line, &l, err, len);
     }
-    if (!header_seen) return exp_fail(err, len, "%s: header: the file is empty (expected %s)", r->path, HEADER);
-    return 0;
+    csv_free(&p);
+    if (!bad && !header_seen) return exp_fail(err, len, "%s: header: the file is empty (expected %s)", r->path, HEADER);
+    return bad;
 }
 
 int exp_gsd_table_load(const char *path, const char *basis_name, dem_gsd *out, char *err, size_t len)
