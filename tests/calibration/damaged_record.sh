@@ -4,13 +4,16 @@
 # says so and that its simulation runs again, exactly that one simulation is rerun, and the
 # table is the same. Two kinds of damage, one after the other: a record cut within a line
 # (no YAML error may be needed to see it), then one whose last line is missing.
-#   usage: damaged_record.sh GRANUCAL SOURCE_DIR WORK_DIR
+#   usage: [REFERENCE=DIR] damaged_record.sh GRANUCAL SOURCE_DIR WORK_DIR
+#   REFERENCE: a finished run of the same command (made once for several tests: tests/CMakeLists.txt),
+#   copied and damaged here; without it, the run is made here.
 set -euo pipefail
 bin=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 cd "$src"
 args=(calibrate configs/calibration.yaml --tier check --material PTFE --jobs 2 --out "$work/run")
-"$bin" "${args[@]}" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
+if [ -n "${REFERENCE:-}" ]; then cp -r "$REFERENCE" "$work/run"
+else "$bin" "${args[@]}" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }; fi
 cp "$work/run/calibrated_parameters.csv" "$work/table.csv"
 records=("$work/run/store/"*.yaml)
 [ "${#records[@]}" -ge 2 ] || { echo "the run stored ${#records[@]} records: nothing to damage"; exit 1; }

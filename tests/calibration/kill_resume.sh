@@ -2,18 +2,21 @@
 # A calibration killed with SIGKILL at 5 different points, then run again with the same
 # command, completes with the same table as an uninterrupted run, reruns nothing already
 # stored, and never leaves a damaged file.
-#   usage: kill_resume.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]   (TIER: check; check-two-tier for the
-#   two-tier search, whose map tier's runs are part of the same store and the same table)
+#   usage: [REFERENCE=DIR] kill_resume.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]   (TIER: check;
+#   check-two-tier for the two-tier search, whose map tier's runs are part of the same store and the
+#   same table). REFERENCE: the uninterrupted run of the same command, made once for several tests
+#   (tests/CMakeLists.txt: calibrate_reference_*); without it, it is made here.
 set -euo pipefail
 bin=$1 src=$2 work=$3 tier=${4:-check}
 rm -rf "$work" && mkdir -p "$work"
 cd "$src"
 args=(calibrate configs/calibration.yaml --tier "$tier" --material PTFE --jobs 2)
-"$bin" "${args[@]}" --out "$work/whole" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
-total=$(($(wc -l < "$work/whole/simulations.csv") - 1))
+whole=${REFERENCE:-$work/whole}
+[ -n "${REFERENCE:-}" ] || "$bin" "${args[@]}" --out "$whole" > "$work/whole.log" 2>&1 || { cat "$work/whole.log"; exit 1; }
+total=$(($(wc -l < "$whole/simulations.csv") - 1))
 # The table's Markdown warns exactly where a value lies outside its identified range; the
 # two-tier run has such values (PTFE: the map's corrected candidates fit better than its own runs).
-python3 tests/calibration/check_value_in_range.py "$work/whole" $([ "$tier" = check-two-tier ] && echo --expect-outside)
+python3 tests/calibration/check_value_in_range.py "$whole" $([ "$tier" = check-two-tier ] && echo --expect-outside)
 # Stored = a record a rerun keeps: not one marking a worker killed from outside (retry: true),
 # which the next run runs again by design.
 records() {
@@ -39,7 +42,7 @@ done
 before=$(records)
 stamp=$(mktemp)
 "$bin" "${args[@]}" --out "$work/killed" > "$work/resume.log" 2>&1 || { cat "$work/resume.log"; exit 1; }
-diff "$work/whole/calibrated_parameters.csv" "$work/killed/calibrated_parameters.csv"
+diff "$whole/calibrated_parameters.csv" "$work/killed/calibrated_parameters.csv"
 ran=$(sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/resume.log")
 echo "resume: ${before} of ${total} records were stored before it; it ran ${ran}"
 [ "$before" -gt 0 ] || { echo "no record survived the kills: the test did not test resuming"; exit 1; }

@@ -3,20 +3,23 @@
 # `mpirun -np 2` gives the same table and the same measurement in every record. With
 # TIER=check-two-tier the two-tier search (its map tier's runs, then the deciding tier's) is
 # spread over the ranks as the standard tier's would be.
-#   usage: mpi_same_table.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]
+#   usage: [REFERENCE=DIR] mpi_same_table.sh GRANUCAL SOURCE_DIR WORK_DIR [TIER]
+#   REFERENCE: the same calibration run without MPI (made once for several tests, on 2 worker
+#   processes: tests/CMakeLists.txt); without it, it is made here on one process.
 set -euo pipefail
 bin=$1 src=$2 work=$3 tier=${4:-check}
 rm -rf "$work" && mkdir -p "$work"
 cd "$src"
 args=(calibrate configs/calibration.yaml --tier "$tier" --material PTFE --jobs 1)
-"$bin" "${args[@]}" --out "$work/serial" > "$work/serial.log" 2>&1 || { cat "$work/serial.log"; exit 1; }
+serial=${REFERENCE:-$work/serial}
+[ -n "${REFERENCE:-}" ] || "$bin" "${args[@]}" --out "$serial" > "$work/serial.log" 2>&1 || { cat "$work/serial.log"; exit 1; }
 mpi=(mpirun -np 2)
 [ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
 "${mpi[@]}" --oversubscribe "$bin" "${args[@]}" --out "$work/mpi" > "$work/mpi.log" 2>&1 || { cat "$work/mpi.log"; exit 1; }
-diff "$work/serial/calibrated_parameters.csv" "$work/mpi/calibrated_parameters.csv"
+diff "$serial/calibrated_parameters.csv" "$work/mpi/calibrated_parameters.csv"
 # Every simulation's measurement (costs aside) is the same whichever rank ran it.
 strip() { cut -d, -f1-15,18-20 "$1"; } # wall, fill and memory columns aside
-diff <(strip "$work/serial/simulations.csv") <(strip "$work/mpi/simulations.csv")
-n=$(($(wc -l < "$work/serial/simulations.csv") - 1))
+diff <(strip "$serial/simulations.csv") <(strip "$work/mpi/simulations.csv")
+n=$(($(wc -l < "$serial/simulations.csv") - 1))
 grep -q "2 rank(s)" "$work/mpi/report.md" || { echo "the MPI run did not see 2 ranks"; exit 1; }
-echo "tier $tier: same table and the same $n simulations from 1 process and from 2 MPI ranks"
+echo "tier $tier: same table and the same $n simulations without MPI and from 2 MPI ranks"

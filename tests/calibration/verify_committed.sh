@@ -21,6 +21,7 @@
 # config.yaml there (calibrate keeps a copy of the config it read) replaces the command's config
 # the same way.
 set -euo pipefail
+source "$(dirname "$0")/random_source.sh"
 bin=$1 src=$2 results=$3 work=$4 n=${5:-2}
 rm -rf "$work" && mkdir -p "$work/out"
 command=$(sed -n 's/^Command: `\(.*\)`.*/\1/p' "$results/report.md")
@@ -44,7 +45,7 @@ if ! grep -q -- "--data" <<< "${args[*]}" && [ -f "$results/repose_angle.csv" ] 
 fi
 cp -r "$results/store" "$work/out/"
 cp "$results"/stage_*.yaml "$work/out/" 2>/dev/null || true
-run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs 1 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
+run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs 2 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
 ran() { sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/$1.log"; }
 fails=0
 
@@ -89,7 +90,7 @@ affordable() {
     echo "$h"
   done
 }
-pick() { shuf -n "$1" --random-source=<(yes "$seed"); }
+pick() { shuf -n "$1" --random-source=<(random_bytes "$seed"); }
 # Two tiers: half the picks (rounded up) from the deciding tier, so a run of the expensive drum is
 # always among them, the rest from the map tier.
 if [ -n "$(records "$stage" map)" ]; then
