@@ -4,6 +4,8 @@
 /// forked process of its own (at most `workers` at a time), so a crash is
 /// one failed simulation, not a lost calibration. Without fork (under MPI,
 /// where forking is unsafe) they run one after the other in this process.
+/// A batch of fewer simulations than workers gives each the idle workers'
+/// cores as OpenMP threads (the same results on any number of threads).
 #ifndef CAL_POOL_H
 #define CAL_POOL_H
 

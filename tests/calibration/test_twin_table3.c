@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Table 3 in CI as a twin experiment. The ci tier is far too coarse to be
+// Table 3 in CI as a twin experiment (usage: test_twin_table3 [TWIN_CALIBRATION_DIR]: with a folder,
+// the rule below is applied to that committed calibration, which CI has verified from its stores;
+// without, the twin is made and calibrated here, as follows). The ci tier is far too coarse to be
 // compared with the lab (its granules pile ~8 deg steeper: docs/fidelity.md),
 // and no tier may be handed a correction measured at the answer. So the data
 // are made by the ci tier itself at Table 3's parameters (results/
