@@ -194,10 +194,6 @@ static void deck_path(char *out, size_t len, const char *dir, const char *code)
     snprintf(out, len, "%s/%s_drum.in", dir, code);
 }
 
-// The solid fraction a pass of LIGGGHTS' random insertion fills the space
-// above the bed to: well below where random insertion jams (about 0.38 for
-// equal spheres, less in a slice a few granules deep).
-#define DECK_PASS_FRACTION 0.12
 #define DECK_POUR_PASS_S 0.2   // s a pass of the pour falls and lands before the next
 #define DECK_SETTLE_S 0.5      // s the bed settles after the pour, and again after the cut
 #define DECK_SPINUP_S 1.0      // s turned before the first frame is dumped
@@ -398,46 +394,6 @@ static void deck_cut_and_dump(FILE *f)
           "dump bed all custom 1 bed.dump id type x y z vx vy vz radius\nrun 0\nundump bed\n", f);
 }
 
-// The smallest prime above n: LIGGGHTS' random seeds are primes above 10000.
-static long prime_above(long n)
-{
-    for (long p = n + 1;; ++p) {
-        long q = 2;
-        while (q * q <= p && p % q) ++q;
-        if (q * q > p) return p;
-    }
-}
-
-// LIGGGHTS' pour: the GSD's classes as templates and a number-based
-// distribution of them, inserted at random without overlap above the bed.
-// Each pass fills the space above the bed to a volume fraction random
-// insertion reaches with room to spare: insert/pack places the largest
-// granules first, so a pass asked for more than fits leaves out the small ones.
-static void liggghts_pour(FILE *f, const deck_scene *s)
-{
-    long seed = prime_above(10000 + 1000 * (long)(s->drum.seed % 1000000));
-    fputs("\n# The pour: the GSD's classes, by number, at random without overlap above the bed, in passes.\n", f);
-    for (int k = 0; k < s->bins; ++k, seed = prime_above(seed))
-        fprintf(f, "fix pts%d all particletemplate/sphere %ld atom_type 1 density constant ${rho} radius constant "
-                   "$(%.6g*v_cg)\n", k + 1, seed, 0.5 * s->bin_d[k]);
-    fprintf(f, "fix pdd all particledistribution/discrete/numberbased %ld %d", seed, s->bins);
-    for (int k = 0; k < s->bins; ++k) fprintf(f, " pts%d %.6g", k + 1, s->bin_p[k]);
-    fprintf(f, "\nvariable pour_seed index %ld   # a prime above 10000: the pour's random places (another, another bed)\n",
-            prime_above(20000 + 1000 * (long)(s->drum.seed % 1000000)));
-    fprintf(f, "variable pitch equal 1.05*v_dmax\n"
-               "region inner cylinder z 0. 0. $(v_rdrum-0.55*v_pitch) 0. ${depth} units box\n"
-               "variable floor string $(-v_rdrum)\n");
-}
-
-static void liggghts_pass(FILE *f)
-{
-    fprintf(f, "region above${pass} block $(-v_rdrum) ${rdrum} ${floor} ${rdrum} 0. ${depth} units box\n"
-               "region sites${pass} intersect 2 inner above${pass}\n"
-               "fix ins all insert/pack seed ${pour_seed} distributiontemplate pdd maxattempt 200 insert_every once "
-               "overlapcheck yes all_in yes vel constant 0. 0. 0. volumefraction_region %g region sites${pass} "
-               "ntry_mc 10000\n", DECK_PASS_FRACTION);
-}
-
 // The drum wall (and a full drum's end plates, which LIGGGHTS' primitive
 // planes cannot turn), turning at `shear` ("" or "shear x ${omega}").
 static void liggghts_walls(FILE *f, const deck_scene *s, const char *shear)
@@ -465,51 +421,17 @@ static void deck_pass_end(FILE *f, const char *after, const char *clearance)
             after, clearance);
 }
 
-static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
-{
-    char path[1200];
-    deck_path(path, sizeof path, dir, "liggghts");
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
-    FILE *f = a.f;
-    deck_title(f, o, "LIGGGHTS 3.8", "liggghts", "liggghts_drum.in", "liggghts_parameters.in");
-    deck_scene_text(f, o, s);
-    deck_step_text(f, s);
-    deck_steps_text(f, "the GSD's classes at random into the drum (insert/pack)");
-    fputs("# Checked against granucal (tests/peers/drum_peers.sh, results/peers/README.md): at the ci twin's table\n"
-          "# and 40 rpm this deck's angle reads 2-3 deg steeper than granucal's drum (LAMMPS' deck agrees), not yet\n"
-          "# explained: compare your own run with granucal's before relying on the angle.\n", f);
-    if (!s->drum.periodic)
-        fputs("# LIGGGHTS' primitive planes cannot turn: the end plates stand still while the drum turns (granucal "
-              "turns\n# them with it).\n", f);
-    deck_variables(f, o, s, "liggghts_drum.dump");
-    fputs("variable wall_type equal v_lining+1\n\natom_style granular\natom_modify map array\ncommunicate single vel yes\n", f);
-    deck_box(f, s, 1 + o->table.n_walls);
-    fputs("include liggghts_parameters.in\ntimestep ${dt}\nfix gravi all gravity 9.81 vector 0. -1. 0.\n", f);
-    liggghts_walls(f, s, "");
-    liggghts_pour(f, s);
-    fputs("fix integr all nve/sphere\n", f);
-    deck_thermo(f);
-    deck_pass_begin(f);
-    liggghts_pass(f);
-    deck_pass_end(f, "unfix ins\n", ""); // insert/pack checks overlaps itself
-    deck_cut_and_dump(f);
-    fputs("\n# The turn: in LIGGGHTS 3.8 a zcylinder's `shear x W` turns it about its axis at W rad/s, counter-clockwise\n"
-          "# seen from +z (`shear z` would slide it along the axis).\nunfix drum\n", f);
-    liggghts_walls(f, s, "shear x ${omega}");
-    fputs("run $(floor(v_spinup/v_dt+0.5))\ndump turn all custom ${every} ${dump} id type x y z vx vy vz radius\n"
-          "run $(floor(v_measure/v_dt+0.5))\n", f);
-    return cal_atomic_commit(&a, err, len);
-}
-
-// LAMMPS' pour, as granucal pours (exp_pour_layer): lattice sites one largest
-// diameter apart filling the drum above the bed, each granule with granucal's
-// small sideways velocity so that they do not land in columns. Each pass's
-// sizes come from the GSD's classes by the golden-ratio sequence of the atom
-// id (LAMMPS 2021's create_atoms has no size distribution, and an atom-style
-// random() drawn twice in a formula draws twice): every pass holds each class
-// at its number fraction to within a granule or two.
-static void lammps_pour(FILE *f, const deck_scene *s)
+// Both decks' pour, as granucal pours (exp_pour_layer): lattice sites one
+// largest diameter apart filling the drum above the bed, each granule with
+// granucal's small sideways velocity so that they do not land in columns. Each
+// pass's sizes come from the GSD's classes by the golden-ratio sequence of the
+// atom id (create_atoms has no size distribution, and an atom-style random()
+// drawn twice in a formula draws twice): every pass holds each class at its
+// number fraction to within a granule or two. The same commands run in LAMMPS
+// 2021 and LIGGGHTS 3.8. LIGGGHTS' own pour (insert/pack, the classes at random
+// without overlap) made beds whose 40 rpm angle read 2.2 deg steeper over three
+// beds than granucal's; poured this way its angle agrees (results/peers/README.md).
+static void lattice_pour(FILE *f, const deck_scene *s)
 {
     fputs("\n# The pour, as granucal's: lattice sites one largest diameter apart above the bed, each granule with a small\n"
           "# sideways velocity (without it they land in columns), in passes.\n"
@@ -523,12 +445,47 @@ static void lammps_pour(FILE *f, const deck_scene *s)
           "variable floor string $(-v_rdrum)\n", f);
 }
 
-static const char lammps_pass[] =
+static const char lattice_pour_text[] = "the GSD's classes on lattice sites above the bed (create_atoms)";
+static const char lattice_pass[] =
     "region above_bed block INF INF ${floor} INF INF INF units box\nregion sites intersect 2 inner above_bed\n"
     "variable before string $(count(all))\ncreate_atoms 1 region sites\ngroup new id > ${before}\n"
     "set group new diameter v_dnew\nset group new density ${rho}\nvelocity new set v_vx v_vy v_vz\n"
     "group new delete\n"
     "region sites delete\nregion above_bed delete\n";
+
+static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
+{
+    char path[1200];
+    deck_path(path, sizeof path, dir, "liggghts");
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    deck_title(f, o, "LIGGGHTS 3.8", "liggghts", "liggghts_drum.in", "liggghts_parameters.in");
+    deck_scene_text(f, o, s);
+    deck_step_text(f, s);
+    deck_steps_text(f, lattice_pour_text);
+    if (!s->drum.periodic)
+        fputs("# LIGGGHTS' primitive planes cannot turn: the end plates stand still while the drum turns (granucal "
+              "turns\n# them with it).\n", f);
+    deck_variables(f, o, s, "liggghts_drum.dump");
+    fputs("variable wall_type equal v_lining+1\n\natom_style granular\natom_modify map array\ncommunicate single vel yes\n", f);
+    deck_box(f, s, 1 + o->table.n_walls);
+    fputs("include liggghts_parameters.in\ntimestep ${dt}\nfix gravi all gravity 9.81 vector 0. -1. 0.\n", f);
+    liggghts_walls(f, s, "");
+    fputs("fix integr all nve/sphere\n", f);
+    lattice_pour(f, s);
+    deck_thermo(f);
+    deck_pass_begin(f);
+    fputs(lattice_pass, f);
+    deck_pass_end(f, "", "+v_pitch"); // a lattice site a pitch above every centre overlaps none
+    deck_cut_and_dump(f);
+    fputs("\n# The turn: in LIGGGHTS 3.8 a zcylinder's `shear x W` turns it about its axis at W rad/s, counter-clockwise\n"
+          "# seen from +z (`shear z` would slide it along the axis).\nunfix drum\n", f);
+    liggghts_walls(f, s, "shear x ${omega}");
+    fputs("run $(floor(v_spinup/v_dt+0.5))\ndump turn all custom ${every} ${dump} id type x y z vx vy vz radius\n"
+          "run $(floor(v_measure/v_dt+0.5))\n", f);
+    return cal_atomic_commit(&a, err, len);
+}
 
 // The drum: a cylinder region (a full drum's closed at its ends), turning
 // when `rotate` is given.
@@ -549,7 +506,7 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     deck_title(f, o, "LAMMPS (pair_style granular)", "lmp", "lammps_drum.in", "lammps_parameters.in");
     deck_scene_text(f, o, s);
     deck_step_text(f, s);
-    deck_steps_text(f, "the GSD's classes on lattice sites above the bed (create_atoms)");
+    deck_steps_text(f, lattice_pour_text);
     deck_variables(f, o, s, "lammps_drum.dump");
     fputs("\natom_style sphere\natom_modify map array\ncomm_modify vel yes\n", f);
     deck_box(f, s, 1);
@@ -562,10 +519,10 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     fputs("timestep ${dt}\nfix gravi all gravity 9.81 vector 0. -1. 0.\n", f);
     lammps_walls(f, s, "still", "");
     fputs("fix integr all nve/sphere\n", f);
-    lammps_pour(f, s);
+    lattice_pour(f, s);
     deck_thermo(f);
     deck_pass_begin(f);
-    fputs(lammps_pass, f);
+    fputs(lattice_pass, f);
     deck_pass_end(f, "", "+v_pitch"); // a lattice site a pitch above every centre overlaps none
     deck_cut_and_dump(f);
     fputs("\n# The turn: the region turns about z at omega rad/s (the wall takes its surface velocity from it).\n"

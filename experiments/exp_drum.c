@@ -447,6 +447,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
         int unmeasured = exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count]);
         out->measure_wall_s += exp_wall_seconds() - measure_start;
         if (unmeasured) break;
+        if (o->on_sample) o->on_sample(s.count, &s.m[s.count], o->sample_ctx);
         s.count++;
         if ((st = check_step(w, o, s.count, &chunk, out)) != DEM_OK) break;
         if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))

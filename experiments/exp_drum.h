@@ -158,6 +158,11 @@ typedef struct exp_drum_run_opts {
     /// NULL: no checkpoints. Not part of what defines a run: a run resumed
     /// from its checkpoints ends as the same run uninterrupted would.
     const exp_drum_checkpoint *checkpoint;
+    /// Called with each measurement of the turn as it is made (index from 0;
+    /// NULL: none): a watcher, not part of what defines a run. A run resumed
+    /// from a checkpoint calls it from the checkpoint's next sample on.
+    void (*on_sample)(int index, const exp_drum_measure *m, void *ctx);
+    void *sample_ctx;
 } exp_drum_run_opts;
 
 exp_drum_run_opts exp_default_drum_run_opts(void);

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+// What a shorter averaging would have measured (issue 37.1; a measurement, not a test). A
+// calibration's drum run averages the angle and CSA over the steady test's two windows and then
+// average_time more; its trajectory does not depend on when it will stop, so one run of the longest
+// averaging holds every shorter one as a prefix. This runs one of a calibration's own drum runs (its
+// record's key rebuilt from the config and checked equal to RECORD's: the same simulation), keeps every
+// sample, and prints the angle and CSA that averaging T s after the steady test would have given, for
+// each T of TIMES, beside the record's own values (which T = the tier's average_time must reproduce to
+// the last digit).
+//   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED RECORD.yaml TIMES
+//   (granule stage: the drum lined with granules; BED 0, 1, 2: the tier's beds, seeds config seed + BED;
+//    TIMES e.g. 0,1,2,3,4,6,8)
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cal_config.h"
+#include "cal_sim.h"
+#include "exp_drum.h"
+
+typedef struct series {
+    int n, cap;
+    exp_drum_measure *m;
+} series;
+
+static void keep(int index, const exp_drum_measure *m, void *ctx)
+{
+    series *s = ctx;
+    if (index >= s->cap) {
+        s->cap = 2 * index + 64;
+        s->m = realloc(s->m, (size_t)s->cap * sizeof *s->m);
+        if (!s->m) abort();
+    }
+    s->m[index] = *m;
+    s->n = index + 1;
+}
+
+// The record's field NAME as text ("" if absent).
+static void record_field(const char *path, const char *name, char *out, size_t len)
+{
+    out[0] = '\0';
+    FILE *f = fopen(path, "r");
+    char line[4096];
+    size_t n = strlen(name);
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, name, n) && line[n] == ':') {
+            char *v = line + n + 1;
+            v += strspn(v, " '");
+            v[strcspn(v, "'\n")] = '\0';
+            snprintf(out, len, "%s", v);
+        }
+    if (f) fclose(f);
+}
+
+static void mean_over(const series *s, int from, int to, double *angle, double *csa)
+{
+    double a = 0, c = 0;
+    for (int i = from; i < to; ++i) a += s->m[i].angle_deg, c += s->m[i].csa_percent;
+    *angle = a / (to - from), *csa = c / (to - from);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 10)
+        return fprintf(stderr, "usage: %s CONFIG TIER K_N MU_S MU_R RPM BED RECORD.yaml TIMES\n", argv[0]), 2;
+    char err[1024], key[4096], recorded_key[4096], text[64];
+    cal_config *c = cal_config_load(argv[1], argv[2], err, sizeof err);
+    if (!c) return fprintf(stderr, "%s\n", err), 1;
+    const cal_tier *t = cal_config_tier(c);
+    double rpm = atof(argv[6]);
+    cal_drum_case d = cal_drum_case_granule(c, t, atof(argv[3]), atof(argv[4]), atof(argv[5]));
+    d.def.seed = d.fill.seed = (uint64_t)(c->seed + atoi(argv[7])); // as the friction stage sets a bed's seed
+    cal_drum_key(&d, rpm, key, sizeof key);
+    record_field(argv[8], "key", recorded_key, sizeof recorded_key);
+    if (strcmp(key, recorded_key))
+        return fprintf(stderr, "not the record's simulation:\n  built  %s\n  record %s\n", key, recorded_key), 1;
+    exp_drum_run_opts o = cal_drum_run_opts(&d, rpm);
+    series s = {0};
+    o.on_sample = keep, o.sample_ctx = &s;
+    dem_world *w = exp_drum_fill(&d.fill, NULL, NULL, err, sizeof err);
+    if (!w) return fprintf(stderr, "%s\n", err), 1;
+    exp_drum_result r;
+    if (exp_drum_rotate(w, &d.def, &o, NULL, NULL, &r) != DEM_OK || !r.steady)
+        return fprintf(stderr, "the run failed or was not steady\n"), 1;
+    int per_window = (int)(o.window / o.sample_interval + 0.5), avg = (int)(o.average_time / o.sample_interval + 0.5);
+    int steady_at = s.n - avg, from = steady_at - 2 * per_window;
+    record_field(argv[8], "angle_deg", text, sizeof text);
+    printf("record %s: angle %s", argv[8], text);
+    record_field(argv[8], "csa_percent", text, sizeof text);
+    printf(", CSA %s; this run: angle %.17g, CSA %.17g; steady test held at %.2f s of turning\n", text, r.angle_deg,
+           r.csa_percent, steady_at * o.sample_interval);
+    char *list = strdup(argv[9]), *save = NULL;
+    for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        double T = atof(tok), angle, csa;
+        int to = steady_at + (int)(T / o.sample_interval + 0.5);
+        if (to > s.n) continue;
+        mean_over(&s, from, to, &angle, &csa);
+        printf("average_time=%g turned_s=%.2f angle_deg=%.17g csa_percent=%.17g\n", T, to * o.sample_interval, angle,
+               csa);
+    }
+    free(list), free(s.m);
+    dem_world_destroy(w);
+    cal_config_free(c);
+    return 0;
+}
