@@ -32,8 +32,10 @@ for h in "${picked[@]}"; do rm "$work/out/store/$h.yaml"; done
 echo "re-deriving: granucal synthesize ${args[*]}"
 (cd "$src" && "$bin" synthesize "${args[@]}" --jobs 2 > "$work/synthesize.log" 2>&1) || { cat "$work/synthesize.log"; exit 1; }
 fails=0
-# A progress line ("[lining] mu_s = ..., 4 rpm, seed 101: ok, ...") is printed for each run simulated here.
-ran=$(grep -c ' rpm, seed [0-9]*: ' "$work/synthesize.log" || true)
+# Each run simulated here prints a line "[lining] mu_s = ..., 4 rpm, seed 101: ok, ..." (and, from a
+# worker turning one bed at several speeds, one more without the pair): runs = distinct lining, speed, seed.
+ran=$(grep -oE '^\[[^]]*\] (mu_s = [^,]*, mu_r = [^,]*, )?[0-9.]+ rpm, seed [0-9]+: ' "$work/synthesize.log" |
+      sed -E 's/mu_s = [^,]*, mu_r = [^,]*, //' | sort -u | wc -l)
 [ "$ran" = "$n" ] || { echo "FAIL: synthesize ran $ran simulations, not the $n removed"; fails=$((fails + 1)); }
 fields='^(key|status|angle_deg|angle_sd_deg|csa_percent|csa_sd_percent|steady|simulated_time_s|dt_s|particle_steps|granules|dt_margin_min|dt_lowered):'
 for h in "${picked[@]}"; do
