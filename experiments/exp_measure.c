@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_vec.h"
+
 exp_raster *exp_raster_create(double radius, double pixel)
 {
     if (!(radius > 0) || !(pixel > 0) || !isfinite(radius) || radius / pixel > 1e5) return NULL;
@@ -129,7 +131,7 @@ int exp_raster_surface_angle(const exp_raster *r, double drum_radius, double cen
     if (m >= 3) {
         double c0, c1, cov00, cov01, cov11, sumsq;
         gsl_fit_linear(xs, 1, ys, 1, (size_t)m, &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-        out->angle_deg = atan(c1) * 180.0 / 3.14159265358979323846;
+        out->angle_deg = atan(c1) * 180.0 / DEM_PI;
         out->residual_sd = sqrt(sumsq / m);
         out->columns = m;
         rc = 0;

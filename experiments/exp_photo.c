@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_vec.h"
 #include "exp_image.h"
 
-#define PI 3.14159265358979323846
 #define CLASS_SMOOTH_PX 1.0        // Gaussian sigma before thresholding: JPEG blocks and noise average out
 #define WALL_BAND_PX 2.5           // next to the circle the rim's blurred edge or shadow darkens the drum
 #define SURFACE_WALL_FRACTION 0.05 // surface points this close to the wall (of R) are the wall's, not the slope's
@@ -336,7 +336,7 @@ static int measure_surface(const drum_box *b, const exp_photo_opts *o, exp_photo
         snprintf(err, len, "the line fit to the free surface failed");
     else {
         out->surface_points = (int)s.n;
-        out->angle_deg = atan(out->line_c1) * 180 / PI;
+        out->angle_deg = atan(out->line_c1) * 180 / DEM_PI;
         out->fit_x0 = s.x[0], out->fit_x1 = s.x[s.n - 1];
         for (size_t k = 0; k < s.n; ++k) out->label[s.pixel[k]] = SURFACE_USED;
         double limit = o->max_sd_fraction * b->c->r;
@@ -450,8 +450,8 @@ static void draw_overlays(const exp_photo_result *r, unsigned char *rgb)
     int w = r->photo->w, h = r->photo->h;
     const unsigned char red[3] = {230, 30, 30}, green[3] = {20, 200, 40};
     const exp_circle *c = &r->circle;
-    for (int k = 0, n = (int)(8 * PI * c->r); k < n; ++k) {
-        double a = 2 * PI * k / n;
+    for (int k = 0, n = (int)(8 * DEM_PI * c->r); k < n; ++k) {
+        double a = 2 * DEM_PI * k / n;
         put(rgb, w, h, c->cx + c->r * cos(a), c->cy + c->r * sin(a), red);
     }
     if (isnan(r->angle_deg)) return;
