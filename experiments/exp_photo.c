@@ -14,6 +14,7 @@
 
 #include "dem_vec.h"
 #include "exp_image.h"
+#include "exp_measure.h"
 
 #define CLASS_SMOOTH_PX 1.0        // Gaussian sigma before thresholding: JPEG blocks and noise average out
 #define WALL_BAND_PX 2.5           // next to the circle the rim's blurred edge or shadow darkens the drum
@@ -168,30 +169,6 @@ static void extend_to_wall(const drum_box *b, unsigned char *powder)
         }
 }
 
-// Dilate (value 1) or erode (value 0) with a disc, within the box.
-static int morph(const drum_box *b, unsigned char *m, int radius, unsigned char value)
-{
-    size_t n = (size_t)b->w * b->h;
-    unsigned char *src = malloc(n);
-    if (!src) return 1;
-    memcpy(src, m, n);
-    for (int y = b->y0; y < b->y1; ++y)
-        for (int x = b->x0; x < b->x1; ++x) {
-            if (src[(size_t)y * b->w + x] == value) continue;
-            int hit = 0;
-            for (int dy = -radius; dy <= radius && !hit; ++dy)
-                for (int dx = -radius; dx <= radius && !hit; ++dx) {
-                    int xx = x + dx, yy = y + dy;
-                    if (dx * dx + dy * dy > radius * radius || xx < b->x0 || yy < b->y0 || xx >= b->x1 || yy >= b->y1)
-                        continue;
-                    hit = src[(size_t)yy * b->w + xx] == value;
-                }
-            if (hit) m[(size_t)y * b->w + x] = value;
-        }
-    free(src);
-    return 0;
-}
-
 // Keep only the largest 4-connected piece of the set pixels in the box.
 static int keep_largest(const drum_box *b, unsigned char *m)
 {
@@ -231,7 +208,7 @@ static int keep_largest(const drum_box *b, unsigned char *m)
 static int shape_powder(const drum_box *b, unsigned char *powder, int closing_px, unsigned char *label)
 {
     extend_to_wall(b, powder);
-    if (closing_px > 0 && (morph(b, powder, closing_px, 1) || morph(b, powder, closing_px, 0))) return 1;
+    if (exp_mask_close(powder, b->w, b->h, b->x0, b->y0, b->x1, b->y1, closing_px)) return 1;
     for (int y = b->y0; y < b->y1; ++y)
         for (int x = b->x0; x < b->x1; ++x) powder[(size_t)y * b->w + x] &= (unsigned char)within(b, x, y, 0);
     if (keep_largest(b, powder)) return 1;
