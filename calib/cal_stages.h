@@ -128,7 +128,7 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
 /// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
 int cal_friction_best(const cal_friction_result *r);
 
-/// The identified ranges (README "Identified ranges"): each candidate's χ²
+/// The identified ranges (docs/calibration.md "Identified ranges"): each candidate's χ²
 /// against every measurement (the angle by its tolerance, each CSA speed by
 /// the lab's and the tier's spreads combined; a failed measurement counts
 /// as 5 standard deviations), then every candidate whose χ² is within

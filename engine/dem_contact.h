@@ -30,7 +30,8 @@ enum dem_feature {
 /// on. The equation, read literally with the sign conventions of eq. 3 and 5
 /// (n_ij points from i to j, v_rel,n·n_ij > 0 while approaching), damps only
 /// while the granules separate. At ξ = 0.7 the four readings give very
-/// different restitution coefficients (see README, tests/unit/test_contact.c).
+/// different restitution coefficients (the table in docs/model.md,
+/// tests/unit/test_contact.c).
 typedef enum dem_damping_mode {
     /// Damped only while approaching: the dashpot never pulls granules
     /// together, consistent with the paper's "adhesive forces are not

@@ -13,11 +13,8 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
+#include "dem_vec.h"
 #include "dem_world.h"
-
-#ifndef DEM_PI
-#define DEM_PI 3.14159265358979323846
-#endif
 
 // Below half a sigma the distribution is all but monodisperse and rejection
 // throws away most draws (acceptance 38% at 0.5); use σ_g = 1 for that.

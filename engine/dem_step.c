@@ -55,7 +55,8 @@ static dem_status apply_limit(dem_world *w, const dem_stability *st, const char 
 // Implicit springs on "auto": on where they are needed, i.e. for a configured
 // step above the explicit integration's own limit (the paper's 0.6 dt_crit),
 // unless the caller asked for the per-granule implicit dashpot. A step left
-// to the engine stays explicit: per simulated second it costs less (README,
+// to the engine stays explicit: per simulated second it costs less
+// (docs/model.md, "What it costs and what it does to collisions";
 // bench_restitution_default_step) and its collisions are more accurate.
 static void decide_integration(dem_world *w)
 {

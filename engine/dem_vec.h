@@ -7,7 +7,8 @@
 
 #include <math.h>
 
-/// π (DEM_PI is not in strict C11).
+/// π (M_PI is not in strict C11): the one definition, used by every folder
+/// (the independent reference, tests/support/ref_two_particles.c, keeps its own).
 #define DEM_PI 3.14159265358979323846
 
 /// Force inlining of a hot kernel that the compiler's size heuristics would

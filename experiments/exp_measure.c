@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_vec.h"
+
 exp_raster *exp_raster_create(double radius, double pixel)
 {
     if (!(radius > 0) || !(pixel > 0) || !isfinite(radius) || radius / pixel > 1e5) return NULL;
@@ -48,35 +50,40 @@ void exp_raster_paint_discs(exp_raster *r, size_t n, const double *x, const doub
     }
 }
 
-// Dilate (value 1) or erode (value 0): a pixel becomes `value` if any pixel
-// of the disc around it has that value.
-static int morph(exp_raster *r, int radius_px, unsigned char value)
+// Dilate (value 1) or erode (value 0) with a disc, within the box: a pixel
+// becomes `value` if any pixel of the disc around it (in the box) has that value.
+static int morph(unsigned char *m, int w, int h, int x0, int y0, int x1, int y1, int radius, unsigned char value)
 {
-    size_t size = (size_t)r->nx * r->ny;
-    unsigned char *src = malloc(size);
+    size_t n = (size_t)w * h;
+    unsigned char *src = malloc(n);
     if (!src) return 1;
-    memcpy(src, r->occupied, size);
-    for (int j = 0; j < r->ny; ++j)
-        for (int i = 0; i < r->nx; ++i) {
-            if (src[(size_t)j * r->nx + i] == value) continue;
+    memcpy(src, m, n);
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            if (src[(size_t)y * w + x] == value) continue;
             int hit = 0;
-            for (int dj = -radius_px; dj <= radius_px && !hit; ++dj)
-                for (int di = -radius_px; di <= radius_px && !hit; ++di) {
-                    int ii = i + di, jj = j + dj;
-                    if (di * di + dj * dj > radius_px * radius_px || ii < 0 || jj < 0 || ii >= r->nx || jj >= r->ny)
-                        continue;
-                    hit = src[(size_t)jj * r->nx + ii] == value;
+            for (int dy = -radius; dy <= radius && !hit; ++dy)
+                for (int dx = -radius; dx <= radius && !hit; ++dx) {
+                    int xx = x + dx, yy = y + dy;
+                    if (dx * dx + dy * dy > radius * radius || xx < x0 || yy < y0 || xx >= x1 || yy >= y1) continue;
+                    hit = src[(size_t)yy * w + xx] == value;
                 }
-            if (hit) r->occupied[(size_t)j * r->nx + i] = value;
+            if (hit) m[(size_t)y * w + x] = value;
         }
     free(src);
     return 0;
 }
 
-int exp_raster_close(exp_raster *r, int radius_px)
+int exp_mask_close(unsigned char *mask, int width, int height, int x0, int y0, int x1, int y1, int radius_px)
 {
     if (radius_px <= 0) return 0;
-    return morph(r, radius_px, 1) || morph(r, radius_px, 0);
+    return morph(mask, width, height, x0, y0, x1, y1, radius_px, 1) ||
+           morph(mask, width, height, x0, y0, x1, y1, radius_px, 0);
+}
+
+int exp_raster_close(exp_raster *r, int radius_px)
+{
+    return exp_mask_close(r->occupied, r->nx, r->ny, 0, 0, r->nx, r->ny, radius_px);
 }
 
 static int inside_circle(const exp_raster *r, int i, int j, double radius)
@@ -129,7 +136,7 @@ int exp_raster_surface_angle(const exp_raster *r, double drum_radius, double cen
     if (m >= 3) {
         double c0, c1, cov00, cov01, cov11, sumsq;
         gsl_fit_linear(xs, 1, ys, 1, (size_t)m, &c0, &c1, &cov00, &cov01, &cov11, &sumsq);
-        out->angle_deg = atan(c1) * 180.0 / 3.14159265358979323846;
+        out->angle_deg = atan(c1) * 180.0 / DEM_PI;
         out->residual_sd = sqrt(sumsq / m);
         out->columns = m;
         rc = 0;

@@ -33,6 +33,12 @@ void exp_raster_paint_discs(exp_raster *r, size_t n, const double *x, const doub
 /// `radius_px` pixels: fills pores and gaps narrower than about 2·radius_px.
 int exp_raster_close(exp_raster *r, int radius_px);
 
+/// The same closing on the part x0 <= x < x1, y0 <= y < y1 of a row-major
+/// mask of width × height bytes (0 or 1): pixels outside that part are
+/// neither read nor changed (a photo's drum box, exp_photo.c). Nothing
+/// happens for radius_px <= 0; non-zero if out of memory.
+int exp_mask_close(unsigned char *mask, int width, int height, int x0, int y0, int x1, int y1, int radius_px);
+
 /// Eq. 20: occupied pixels inside the drum circle over all pixels inside
 /// it, in %.
 double exp_raster_csa_percent(const exp_raster *r, double drum_radius);

@@ -12,9 +12,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_vec.h"
 #include "exp_image.h"
+#include "exp_measure.h"
 
-#define PI 3.14159265358979323846
 #define CLASS_SMOOTH_PX 1.0        // Gaussian sigma before thresholding: JPEG blocks and noise average out
 #define WALL_BAND_PX 2.5           // next to the circle the rim's blurred edge or shadow darkens the drum
 #define SURFACE_WALL_FRACTION 0.05 // surface points this close to the wall (of R) are the wall's, not the slope's
@@ -168,30 +169,6 @@ static void extend_to_wall(const drum_box *b, unsigned char *powder)
         }
 }
 
-// Dilate (value 1) or erode (value 0) with a disc, within the box.
-static int morph(const drum_box *b, unsigned char *m, int radius, unsigned char value)
-{
-    size_t n = (size_t)b->w * b->h;
-    unsigned char *src = malloc(n);
-    if (!src) return 1;
-    memcpy(src, m, n);
-    for (int y = b->y0; y < b->y1; ++y)
-        for (int x = b->x0; x < b->x1; ++x) {
-            if (src[(size_t)y * b->w + x] == value) continue;
-            int hit = 0;
-            for (int dy = -radius; dy <= radius && !hit; ++dy)
-                for (int dx = -radius; dx <= radius && !hit; ++dx) {
-                    int xx = x + dx, yy = y + dy;
-                    if (dx * dx + dy * dy > radius * radius || xx < b->x0 || yy < b->y0 || xx >= b->x1 || yy >= b->y1)
-                        continue;
-                    hit = src[(size_t)yy * b->w + xx] == value;
-                }
-            if (hit) m[(size_t)y * b->w + x] = value;
-        }
-    free(src);
-    return 0;
-}
-
 // Keep only the largest 4-connected piece of the set pixels in the box.
 static int keep_largest(const drum_box *b, unsigned char *m)
 {
@@ -231,7 +208,7 @@ static int keep_largest(const drum_box *b, unsigned char *m)
 static int shape_powder(const drum_box *b, unsigned char *powder, int closing_px, unsigned char *label)
 {
     extend_to_wall(b, powder);
-    if (closing_px > 0 && (morph(b, powder, closing_px, 1) || morph(b, powder, closing_px, 0))) return 1;
+    if (exp_mask_close(powder, b->w, b->h, b->x0, b->y0, b->x1, b->y1, closing_px)) return 1;
     for (int y = b->y0; y < b->y1; ++y)
         for (int x = b->x0; x < b->x1; ++x) powder[(size_t)y * b->w + x] &= (unsigned char)within(b, x, y, 0);
     if (keep_largest(b, powder)) return 1;
@@ -336,7 +313,7 @@ static int measure_surface(const drum_box *b, const exp_photo_opts *o, exp_photo
         snprintf(err, len, "the line fit to the free surface failed");
     else {
         out->surface_points = (int)s.n;
-        out->angle_deg = atan(out->line_c1) * 180 / PI;
+        out->angle_deg = atan(out->line_c1) * 180 / DEM_PI;
         out->fit_x0 = s.x[0], out->fit_x1 = s.x[s.n - 1];
         for (size_t k = 0; k < s.n; ++k) out->label[s.pixel[k]] = SURFACE_USED;
         double limit = o->max_sd_fraction * b->c->r;
@@ -450,8 +427,8 @@ static void draw_overlays(const exp_photo_result *r, unsigned char *rgb)
     int w = r->photo->w, h = r->photo->h;
     const unsigned char red[3] = {230, 30, 30}, green[3] = {20, 200, 40};
     const exp_circle *c = &r->circle;
-    for (int k = 0, n = (int)(8 * PI * c->r); k < n; ++k) {
-        double a = 2 * PI * k / n;
+    for (int k = 0, n = (int)(8 * DEM_PI * c->r); k < n; ++k) {
+        double a = 2 * DEM_PI * k / n;
         put(rgb, w, h, c->cx + c->r * cos(a), c->cy + c->r * sin(a), red);
     }
     if (isnan(r->angle_deg)) return;

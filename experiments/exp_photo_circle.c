@@ -13,9 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_vec.h"
 #include "exp_image.h"
 
-#define PI 3.14159265358979323846
 #define EDGE_SMOOTH_PX 1.5     // Gaussian sigma before edges: single-pixel pores and noise fade, rims stay
 #define MIN_SUPPORT 0.25       // a drum edge is seen along at least this fraction of the rays
 #define ON_CIRCLE_PX 1.5       // an edge point this close to a circle lies on it
@@ -135,7 +135,7 @@ static void ray_derivatives(const exp_gray *s, double cx, double cy, double s0, 
     double *profile = malloc((size_t)samples * sizeof *profile);
     if (!profile) return;
     for (int k = 0; k < rays; ++k) {
-        double a = 2 * PI * k / rays, ca = cos(a), sa = sin(a);
+        double a = 2 * DEM_PI * k / rays, ca = cos(a), sa = sin(a);
         for (int i = 0; i < samples; ++i) {
             double t = s0 + i * RAY_STEP_PX;
             profile[i] = bilinear(s, cx + t * ca, cy + t * sa);
@@ -152,7 +152,7 @@ static void ray_derivatives(const exp_gray *s, double cx, double cy, double s0, 
 // weaker inner edge (powder against a dark rim) still does.
 static int ray_edges(const exp_gray *s, double cx, double cy, double s0, double s1, edge_set *out)
 {
-    int samples = (int)((s1 - s0) / RAY_STEP_PX) + 1, rays = (int)fmin(2048, fmax(180, PI * 0.5 * (s0 + s1)));
+    int samples = (int)((s1 - s0) / RAY_STEP_PX) + 1, rays = (int)fmin(2048, fmax(180, DEM_PI * 0.5 * (s0 + s1)));
     float *d = malloc((size_t)samples * rays * sizeof *d);
     double *strongest = malloc((size_t)rays * sizeof *strongest);
     if (!d || !strongest) return free(d), free(strongest), 1;
@@ -172,7 +172,7 @@ static int ray_edges(const exp_gray *s, double cx, double cy, double s0, double 
             double m = fabs(dk[i]), before = fabs(dk[i - 1]), after = fabs(dk[i + 1]);
             if (!(m >= threshold && m >= before && m > after) || dk[i - 1] * dk[i] < 0) continue;
             double shift = 0.5 * (before - after) / (before - 2 * m + after); // parabola through the three
-            double t = s0 + (i + (isfinite(shift) ? shift : 0)) * RAY_STEP_PX, a = 2 * PI * k / rays;
+            double t = s0 + (i + (isfinite(shift) ? shift : 0)) * RAY_STEP_PX, a = 2 * DEM_PI * k / rays;
             failed = edge_push(out, k, cx + t * cos(a), cy + t * sin(a));
         }
     }

@@ -1,18 +1,24 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""The engine's layering, checked (issue 23).
+"""The layering of the tree, checked (docs/architecture.md is the map).
 
     check_layers.py ROOT [LIBDEM]
 
-Fails (exit 1, with the offending files named) on
+The folders are layered one way: engine/ -> experiments/ -> calib/ (tests/ may
+use any of them). Fails (exit 1, naming each offending file and line) on
+  * a file in engine/ including an experiments or calib header (exp_*.h,
+    cal_*.h, or any header that lives in experiments/ or calib/);
+  * a file in experiments/ including a calib header (cal_*.h, or any header
+    that lives in calib/);
   * an include cycle inside engine/ between modules. A module is one stem:
     engine/dem_foo.c and dem_foo_internal.h are module dem_foo, so dem_foo.c
     including dem_bar_internal.h while dem_bar_internal.h includes
     dem_foo_internal.h is a cycle, although no header includes itself. A
     public header (dem_foo.h) is a node of its own;
-  * a file outside engine/ (calib/, experiments/, tests/) including an
-    engine-private header: by convention, any engine/*_internal.h. The engine's
-    own unit tests may, where ENGINE_TESTS below lists them with the reason;
+  * a file outside engine/ (any folder of ROOT but engine/, hidden folders
+    and build trees) including an engine-private header: by convention, any
+    engine/*_internal.h. The engine's own unit tests may, where ENGINE_TESTS
+    below lists them with the reason;
   * with LIBDEM (the built libdem.a): a call cycle between the engine's object
     files, read from their defined and undefined symbols (nm). Functions inline
     in a header are not calls: their header's include edges are checked above.
@@ -32,8 +38,11 @@ ENGINE_TESTS = {
 # entry is the start of a problem's first line; empty once the engine is layered.
 KNOWN = []
 
-INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
-OUTSIDE = ("calib", "experiments", "tests")
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]')
+
+# The folders above the engine, lowest first, with the prefix of their files:
+# a folder may include from the ones before it, never from the ones after.
+LAYERS = (("engine", "dem_"), ("experiments", "exp_"), ("calib", "cal_"))
 
 
 def module_of(name):
@@ -45,9 +54,28 @@ def module_of(name):
     return stem[: -len("_internal")] if stem.endswith("_internal") else stem
 
 
-def includes(path):
+def include_lines(path):
+    """(line number, included name as written) of each #include in a file."""
     with open(path, encoding="utf-8", errors="replace") as f:
-        return INCLUDE.findall(f.read())
+        return [(k, m.group(1)) for k, line in enumerate(f, 1) for m in [INCLUDE.match(line)] if m]
+
+
+def includes(path):
+    return [name for _, name in include_lines(path)]
+
+
+def skipped(path):
+    """A hidden folder, or a build tree (one with a CMakeCache.txt): not source."""
+    return os.path.basename(path).startswith(".") or os.path.exists(os.path.join(path, "CMakeCache.txt"))
+
+
+def sources(root, top):
+    """The .c and .h files under ROOT/top, sorted, skipped folders left out."""
+    out = []
+    for dirpath, dirs, names in os.walk(os.path.join(root, top)):
+        dirs[:] = sorted(d for d in dirs if not skipped(os.path.join(dirpath, d)))
+        out += [os.path.join(dirpath, n) for n in sorted(names) if n.endswith((".c", ".h"))]
+    return out
 
 
 def cycles(graph):
@@ -108,20 +136,41 @@ def include_problems(root):
         problems.append("include cycle in engine/ between modules %s:" % ", ".join(comp))
         problems += explain(comp, edges)
     private = {f for f in files if f.endswith("_internal.h")}
-    for top in OUTSIDE:
-        for dirpath, _, names in os.walk(os.path.join(root, top)):
-            for n in sorted(names):
-                if not n.endswith((".c", ".h")):
-                    continue
-                path = os.path.join(dirpath, n)
-                rel = os.path.relpath(path, root)
-                allowed = ENGINE_TESTS.get(rel, set())
-                for inc in includes(path):
-                    if inc in private and inc not in allowed:
-                        problems.append('%s includes the engine-private header "%s" (use the public API in '
-                                        "engine/dem_*.h, or list an engine unit test in ENGINE_TESTS with a reason)"
-                                        % (rel, inc))
+    outside = sorted(d for d in os.listdir(root) if d != "engine" and os.path.isdir(os.path.join(root, d))
+                     and not skipped(os.path.join(root, d)))
+    for top in outside:
+        for path in sources(root, top):
+            rel = os.path.relpath(path, root)
+            allowed = ENGINE_TESTS.get(rel, set())
+            for line, inc in include_lines(path):
+                name = os.path.basename(inc)
+                if name in private and name not in allowed:
+                    problems.append('%s:%d: includes the engine-private header "%s" (outside engine/ use the '
+                                    "public API in engine/dem_*.h, or list an engine unit test in ENGINE_TESTS "
+                                    "with a reason)" % (rel, line, inc))
     return problems, graph
+
+
+def folder_problems(root):
+    """Includes against the one-way order of LAYERS: a file in a folder naming a
+    header of a folder above it (by its prefix, or because it lives there)."""
+    headers = {top: {os.path.basename(p) for p in sources(root, top) if p.endswith(".h")} for top, _ in LAYERS}
+    problems = []
+    for k, (low, _) in enumerate(LAYERS):
+        above = LAYERS[k + 1:]
+        for path in sources(root, low):
+            rel = os.path.relpath(path, root)
+            for line, inc in include_lines(path):
+                name = os.path.basename(inc)
+                if name in headers[low]:
+                    continue
+                for high, prefix in above:
+                    if name.startswith(prefix) or name in headers[high]:
+                        problems.append('%s:%d: includes "%s", a header of %s/, which is above %s/ (the layers go '
+                                        "one way: %s; move what both need down, or the code up)"
+                                        % (rel, line, inc, high, low, " -> ".join(t + "/" for t, _ in LAYERS)))
+                        break
+    return problems
 
 
 def call_problems(lib):
@@ -158,6 +207,7 @@ def main():
         return 2
     root = sys.argv[1]
     problems, graph = include_problems(root)
+    problems += folder_problems(root)
     if len(sys.argv) == 3:
         problems += call_problems(sys.argv[2])
     blocks = []  # each problem's first line and its explanation lines
@@ -171,11 +221,13 @@ def main():
     for b in known:
         print("\n".join(["known, being removed (issue 23): " + b[0]] + b[1:]))
     if failing:
-        print("engine layering: %d problem(s)" % len(failing))
+        print("layering: %d problem(s)" % len(failing))
         print("\n".join(line for b in failing for line in b))
         return 1
-    print("engine layering: %d modules; %s include cycle, no private header used outside engine/%s"
-          % (len(graph), "no other" if known else "no", ", no call cycle" if len(sys.argv) == 3 else ""))
+    print("layering: engine/ %d modules, %s include cycle%s; no private header used outside engine/; "
+          "includes one way, %s"
+          % (len(graph), "no other" if known else "no", ", no call cycle" if len(sys.argv) == 3 else "",
+             " -> ".join(t + "/" for t, _ in LAYERS)))
     return 0
 
 

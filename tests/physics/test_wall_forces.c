@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "dem_checkpoint.h"
+#include "dem_vec.h"
 #include "dem_world.h"
 
 static const double G = 9.81, RHO = 1800.0, R = 1e-3;
@@ -140,7 +141,7 @@ static void test_total_survives_sort_clone_checkpoint(void **state)
 static void test_incline_carries_the_weight_vector(void **state)
 {
     (void)state;
-    const double th = 10.0 * 3.14159265358979323846 / 180.0;
+    const double th = 10.0 * DEM_PI / 180.0;
     dem_world_def def = dem_default_world_def();
     def.granule = contact(500, 0.7, 0.8, 0.5);
     def.domain_lo = dem_v3(-0.05, -0.05, -0.05), def.domain_hi = dem_v3(0.05, 0.05, 0.05);

@@ -21,12 +21,9 @@
 
 #include "dem_gsd.h"
 #include "dem_scaling.h"
+#include "dem_vec.h"
 #include "dem_world.h"
 #include "exp_gsd_table.h"
-
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 
 enum { N_DRAWS = 200000 };
 static const uint64_t SEED = 20190501u;
@@ -171,7 +168,7 @@ static double quadrature_mean_volume(const dem_gsd *g)
     gsl_integration_qags(&f, dem_gsd_min_diameter(g), dem_gsd_max_diameter(g), 0.0, 1e-12, 1000, w, &moment, &err);
     gsl_integration_workspace_free(w);
     double t = g->truncation_sigmas;
-    return M_PI / 6.0 * moment / (gsl_cdf_ugaussian_P(t) - gsl_cdf_ugaussian_P(-t));
+    return DEM_PI / 6.0 * moment / (gsl_cdf_ugaussian_P(t) - gsl_cdf_ugaussian_P(-t));
 }
 
 static void test_mean_volume(void **state)
@@ -180,10 +177,10 @@ static void test_mean_volume(void **state)
     dem_gsd g = dem_default_gsd();
     double *d = draw(&g, SEED, N_DRAWS);
     double sum = 0.0;
-    for (size_t i = 0; i < N_DRAWS; i++) sum += M_PI / 6.0 * d[i] * d[i] * d[i];
+    for (size_t i = 0; i < N_DRAWS; i++) sum += DEM_PI / 6.0 * d[i] * d[i] * d[i];
     double mc = sum / N_DRAWS, analytic = dem_gsd_mean_volume(&g), quad = quadrature_mean_volume(&g);
     print_message("mean volume: analytic %.8g, quadrature %.8g, Monte Carlo %.8g m^3 (median sphere %.8g)\n",
-                  analytic, quad, mc, M_PI / 6.0 * pow(200e-6, 3));
+                  analytic, quad, mc, DEM_PI / 6.0 * pow(200e-6, 3));
     assert_rel(analytic, quad, 1e-9, "analytic vs quadrature mean volume");
     assert_rel(analytic, mc, 0.01, "analytic vs Monte Carlo mean volume");
     // A wider cut keeps more of the heavy upper tail: the mean volume grows.
@@ -201,7 +198,7 @@ static void test_monodisperse(void **state)
     double d[64];
     assert_int_equal(dem_gsd_sample(&g, SEED, 64, d), DEM_OK);
     for (size_t i = 0; i < 64; i++) assert_true(d[i] == 1e-3);
-    assert_rel(dem_gsd_mean_volume(&g), M_PI / 6.0 * 1e-9, 1e-14, "monodisperse mean volume");
+    assert_rel(dem_gsd_mean_volume(&g), DEM_PI / 6.0 * 1e-9, 1e-14, "monodisperse mean volume");
 }
 
 static void test_count_for_volume(void **state)
@@ -299,7 +296,7 @@ enum { TABLE_ROWS = 161 };
 // Sampling error of a median of ln d (sqrt(pi/2) s / sqrt(N)) and of a
 // standard deviation (s / sqrt(2N)), with 4 of them as the tolerance; the
 // table's own discretisation (classes 0.05 s wide) is far below.
-static double median_tolerance(double s) { return 4.0 * sqrt(M_PI / 2.0) * s / sqrt(N_DRAWS); }
+static double median_tolerance(double s) { return 4.0 * sqrt(DEM_PI / 2.0) * s / sqrt(N_DRAWS); }
 static double sd_tolerance(double s) { return 4.0 * s / sqrt(2.0 * N_DRAWS); }
 
 static void test_number_table_is_its_lognormal(void **state)
@@ -367,7 +364,7 @@ static void test_table_volume_scaling_determinism(void **state)
     char msg[256];
     assert_int_equal(dem_gsd_from_table(d, pct, TABLE_ROWS, DEM_GSD_VOLUME, &g, &row, msg, sizeof msg), 0);
     double *a = draw(&g, SEED, N_DRAWS), *b = draw(&g, SEED, N_DRAWS / 2), sum = 0.0;
-    for (size_t i = 0; i < N_DRAWS; i++) sum += M_PI / 6.0 * a[i] * a[i] * a[i];
+    for (size_t i = 0; i < N_DRAWS; i++) sum += DEM_PI / 6.0 * a[i] * a[i] * a[i];
     assert_memory_equal(a, b, (N_DRAWS / 2) * sizeof *a);
     for (size_t i = 0; i < N_DRAWS; i++) assert_true(a[i] >= d[0] && a[i] <= d[TABLE_ROWS - 1]);
     assert_rel(dem_gsd_mean_volume(&g), sum / N_DRAWS, 0.01, "table mean volume vs Monte Carlo");
@@ -390,7 +387,7 @@ static void expect_classes(const dem_gsd *g, int max, int want_n)
     int n = dem_gsd_classes(g, max, d, p);
     assert_int_equal(n, want_n);
     for (int k = 0; k < n; k++) {
-        sum += p[k], volume += p[k] * M_PI / 6.0 * d[k] * d[k] * d[k];
+        sum += p[k], volume += p[k] * DEM_PI / 6.0 * d[k] * d[k] * d[k];
         assert_true(d[k] >= dem_gsd_min_diameter(g) && d[k] <= dem_gsd_max_diameter(g));
         if (k) assert_true(d[k] > d[k - 1]);
     }

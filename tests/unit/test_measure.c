@@ -13,11 +13,11 @@
 #include <math.h>
 
 #include "exp_measure.h"
+#include "dem_vec.h"
 
 #define DRUM_R 0.05  // m, the paper's 100 mm drum
 #define GRAIN_R 1e-3 // m
 #define PIXEL 2e-4   // m: 500 pixels across the drum, 10 per granule diameter
-#define PI 3.14159265358979323846
 
 #define FINE_R (1.5 * PIXEL) // fine granules, so the bed's edges are sharp
 
@@ -26,7 +26,7 @@
 // half the drum and its surface is that line.
 static size_t tilted_bed(double tilt_deg, double *x, double *y, double *r, size_t cap)
 {
-    double c = cos(tilt_deg * PI / 180), s = sin(tilt_deg * PI / 180), step = FINE_R;
+    double c = cos(tilt_deg * DEM_PI / 180), s = sin(tilt_deg * DEM_PI / 180), step = FINE_R;
     size_t n = 0;
     for (double v = -FINE_R; v > -DRUM_R; v -= step)
         for (double u = -DRUM_R; u <= DRUM_R; u += step) {
@@ -86,9 +86,9 @@ static void test_ring_area(void **state)
     // A lone ring of separate granules (gaps of 0.2 r): the area is exactly
     // n·π·r², i.e. n·r²/R² of the drum, up to the pixelisation of the discs.
     const double rho = 0.03;
-    int n = (int)(2 * PI * rho / (2.2 * GRAIN_R));
+    int n = (int)(2 * DEM_PI * rho / (2.2 * GRAIN_R));
     double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y), *r = malloc(n * sizeof *r);
-    for (int k = 0; k < n; ++k) x[k] = rho * cos(2 * PI * k / n), y[k] = rho * sin(2 * PI * k / n), r[k] = GRAIN_R;
+    for (int k = 0; k < n; ++k) x[k] = rho * cos(2 * DEM_PI * k / n), y[k] = rho * sin(2 * DEM_PI * k / n), r[k] = GRAIN_R;
     exp_raster *img = exp_raster_create(DRUM_R, PIXEL / 2);
     exp_raster_paint_discs(img, (size_t)n, x, y, r);
     double csa = exp_raster_csa_percent(img, DRUM_R), expected = 100.0 * n * GRAIN_R * GRAIN_R / (DRUM_R * DRUM_R);
@@ -110,13 +110,13 @@ static void test_closing_fills_pores(void **state)
         for (int j = 0; j < 20; ++j) x[n] = (2 * i - 19) * GRAIN_R, y[n] = (2 * j - 19) * GRAIN_R, r[n++] = GRAIN_R;
     exp_raster *img = exp_raster_create(DRUM_R, PIXEL / 2);
     exp_raster_paint_discs(img, (size_t)n, x, y, r);
-    double square = 100.0 * (40 * GRAIN_R) * (40 * GRAIN_R) / (PI * DRUM_R * DRUM_R);
+    double square = 100.0 * (40 * GRAIN_R) * (40 * GRAIN_R) / (DEM_PI * DRUM_R * DRUM_R);
     double before = exp_raster_csa_percent(img, DRUM_R);
     assert_int_equal(exp_raster_close(img, 4), 0);
     double after = exp_raster_csa_percent(img, DRUM_R);
     printf("square of touching granules: %.3f %% open, %.3f %% closed; the square is %.3f %%, pi/4 of it %.3f %%\n",
-           before, after, square, square * PI / 4);
-    assert_true(fabs(before - square * PI / 4) < 0.02 * square);
+           before, after, square, square * DEM_PI / 4);
+    assert_true(fabs(before - square * DEM_PI / 4) < 0.02 * square);
     // Closed: the pores are gone; the scallops of the outline stay (a disc
     // of 4 pixels cannot enter them), at most 1 - π/4 of a border strip.
     assert_true(after > before + 0.15 * square && after <= square * 1.001);

@@ -16,6 +16,7 @@
 #include <math.h>
 #include <png.h>
 
+#include "dem_vec.h"
 #include "exp_image.h"
 
 #define W 600
@@ -27,7 +28,7 @@
 static void render(const char *path, double tilt, int light_powder)
 {
     unsigned char *px = malloc(W * W);
-    double s = sin(tilt * 3.14159265358979323846 / 180), c = cos(tilt * 3.14159265358979323846 / 180);
+    double s = sin(tilt * DEM_PI / 180), c = cos(tilt * DEM_PI / 180);
     unsigned seed = 12345;
     for (int y = 0; y < W; ++y)
         for (int x = 0; x < W; ++x) {

@@ -23,9 +23,9 @@
 
 #include "cal_commands.h"
 #include "cal_data.h"
+#include "dem_vec.h"
 #include "exp_photo.h"
 
-#define PI 3.14159265358979323846
 #define SUPERSAMPLE 4 // per axis: pixels at the edges are the covered fraction, as a camera's
 
 // A photograph to draw: the drum (interior radius r) with the powder below a
@@ -57,8 +57,8 @@ static double surface_offset(double fill)
 {
     double lo = -1, hi = 1;
     for (int it = 0; it < 60; ++it) {
-        double t = 0.5 * (lo + hi), below = PI - acos(t) + t * sqrt(1 - t * t);
-        if (below / PI < fill) lo = t;
+        double t = 0.5 * (lo + hi), below = DEM_PI - acos(t) + t * sqrt(1 - t * t);
+        if (below / DEM_PI < fill) lo = t;
         else hi = t;
     }
     return 0.5 * (lo + hi);
@@ -73,17 +73,17 @@ static double uniform(unsigned *seed)
 static double gaussian(unsigned *seed)
 {
     double u = fmax(1e-12, uniform(seed)), v = uniform(seed);
-    return sqrt(-2 * log(u)) * cos(2 * PI * v);
+    return sqrt(-2 * log(u)) * cos(2 * DEM_PI * v);
 }
 
 // Grey level at a point of the picture (image coordinates), pores aside.
 static double grey_at(const scene *s, double x, double y, double offset)
 {
-    double dx = x - s->cx, dy = s->cy - y, rho = hypot(dx, dy), a = s->angle_deg * PI / 180;
+    double dx = x - s->cx, dy = s->cy - y, rho = hypot(dx, dy), a = s->angle_deg * DEM_PI / 180;
     if (rho > s->r + s->rim_px) return s->surround;
     if (rho > s->r) return s->rim;
     double along = cos(a) * dx + sin(a) * dy, up = -sin(a) * dx + cos(a) * dy;
-    double wave = s->wave_px * sin(2 * PI * along / (0.5 * s->r));
+    double wave = s->wave_px * sin(2 * DEM_PI * along / (0.5 * s->r));
     return up < offset * s->r + wave ? s->powder : s->drum;
 }
 
@@ -96,7 +96,7 @@ static int in_powder(const scene *s, double x, double y, double offset)
 static void add_pores(const scene *s, double offset, double *v)
 {
     unsigned seed = s->seed * 7919u + 1;
-    double area = s->fill * PI * s->r * s->r, covered = 0;
+    double area = s->fill * DEM_PI * s->r * s->r, covered = 0;
     while (covered < s->pores * area) {
         double x = uniform(&seed) * s->w, y = uniform(&seed) * s->h, pr = 0.7 + 1.3 * uniform(&seed);
         if (!in_powder(s, x, y, offset)) continue;
@@ -105,7 +105,7 @@ static void add_pores(const scene *s, double offset, double *v)
                 if (i >= 0 && j >= 0 && i < s->w && j < s->h && hypot(i + 0.5 - x, j + 0.5 - y) <= pr &&
                     in_powder(s, i + 0.5, j + 0.5, offset))
                     v[(size_t)j * s->w + i] = s->drum;
-        covered += PI * pr * pr;
+        covered += DEM_PI * pr * pr;
     }
 }
 

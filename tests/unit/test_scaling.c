@@ -13,10 +13,7 @@
 #include "dem_contact.h"
 #include "dem_gsd.h"
 #include "dem_scaling.h"
-
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
+#include "dem_vec.h"
 
 static const double LAMBDAS[] = {8.0, 27.0, 64.0, 125.0};
 enum { N_LAMBDAS = sizeof LAMBDAS / sizeof LAMBDAS[0] };
@@ -33,7 +30,7 @@ static void assert_rel(double got, double want, double rel, const char *what)
     }
 }
 
-static double sphere_mass(double r, double rho) { return rho * 4.0 / 3.0 * M_PI * r * r * r; }
+static double sphere_mass(double r, double rho) { return rho * 4.0 / 3.0 * DEM_PI * r * r * r; }
 
 static void test_mass_conserved(void **state)
 {
