@@ -10,9 +10,9 @@
 #include "cal_util.h"
 #include "dem_checkpoint.h"
 #include "exp_common.h"
-#include "dem_output.h"
 #include "exp_drum_config.h"
 #include "exp_image.h"
+#include "exp_result.h"
 
 typedef struct progress_state {
     int tty;
@@ -50,19 +50,13 @@ static int save(const char *dir, const exp_drum_yaml *y, const exp_drum_result *
                 const char *status)
 {
     char path[1200], err[1024];
-    snprintf(path, sizeof path, "%s/result.h5", dir);
-    dem_h5_writer *h5 = dem_h5_open(path, err, sizeof err);
-    dem_granules_view g = dem_world_granules(w);
-    dem_diagnostics d = dem_world_diagnose(w);
-    int bad = !h5 || dem_h5_write_frame(h5, dem_world_time(w), &g, &d) ||
-              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
-    if (h5) bad |= dem_h5_close(h5, err, sizeof err);
+    int bad = exp_result_write_h5(dir, w, err, sizeof err);
     // The drum face at the end of the run (like the paper's Fig. 14), by size.
     snprintf(path, sizeof path, "%s/drum_face.png", dir);
     if (!bad) bad = exp_render_drum_png(path, w, 0.5 * y->diameter, 800, EXP_COLOUR_SIZE, err, sizeof err);
     cal_atomic_file json;
     snprintf(path, sizeof path, "%s/result.json", dir);
-    if (!bad && !cal_atomic_open(&json, path, err, sizeof err)) {
+    if (!bad && !(bad = cal_atomic_open(&json, path, err, sizeof err))) {
         write_json(json.f, y, r, w, status);
         bad = cal_atomic_commit(&json, err, sizeof err);
     }

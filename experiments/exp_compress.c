@@ -12,11 +12,11 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "dem_output.h"
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_pour.h"
+#include "exp_result.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
 
@@ -516,16 +516,7 @@ static int write_outputs(const char *dir, const compress_yaml *y, const exp_comp
     snprintf(path, sizeof path, "%s/curve.csv", dir);
     snprintf(png, sizeof png, "%s/force_displacement.png", dir);
     int bad = exp_compress_write_curve(r, path, png, err, sizeof err);
-    if (!bad) {
-        snprintf(path, sizeof path, "%s/result.h5", dir);
-        dem_h5_writer *h5 = dem_h5_open(path, err, sizeof err);
-        dem_granules_view g = dem_world_granules(w);
-        dem_diagnostics dg = dem_world_diagnose(w);
-        bad = !h5 || dem_h5_write_frame(h5, dem_world_time(w), &g, &dg) ||
-              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
-        if (h5 && bad) snprintf(err, sizeof err, "%s", dem_h5_error(h5));
-        if (h5) bad |= dem_h5_close(h5, err, sizeof err);
-    }
+    if (!bad) bad = exp_result_write_h5(dir, w, err, sizeof err);
     if (!bad) {
         snprintf(path, sizeof path, "%s/result.json", dir);
         snprintf(tmp, sizeof tmp, "%s.tmp", path);

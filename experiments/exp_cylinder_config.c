@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dem_output.h"
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
 #include "exp_pour.h"
+#include "exp_result.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
 
@@ -192,16 +192,7 @@ int exp_cylinder_write_outputs(const char *dir, const exp_cylinder_def *d, const
 {
     char path[1100], tmp[1200];
     if (exp_mkdirs(dir, err, len)) return 1;
-    snprintf(path, sizeof path, "%s/result.h5", dir);
-    dem_h5_writer *h5 = dem_h5_open(path, err, len);
-    if (!h5) return 1;
-    dem_granules_view g = dem_world_granules(w);
-    dem_diagnostics dg = dem_world_diagnose(w);
-    int bad = dem_h5_write_frame(h5, dem_world_time(w), &g, &dg) ||
-              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
-    if (bad) exp_fail(err, len, "%s", dem_h5_error(h5));
-    if (dem_h5_close(h5, bad ? NULL : err, bad ? 0 : len)) bad = 1;
-    if (bad) return 1;
+    if (exp_result_write_h5(dir, w, err, len)) return 1;
     snprintf(path, sizeof path, "%s/result.json", dir);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");

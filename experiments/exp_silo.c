@@ -10,9 +10,9 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "dem_output.h"
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
+#include "exp_result.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
 
@@ -480,15 +480,7 @@ int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out
     snprintf(p, sizeof p, "%s/series.csv", dir);
     snprintf(prefix, sizeof prefix, "%s/", dir);
     bad = bad || exp_silo_write_series(&r, p, prefix, err, sizeof err);
-    if (!bad) {
-        snprintf(p, sizeof p, "%s/result.h5", dir);
-        dem_h5_writer *h5 = dem_h5_open(p, err, sizeof err);
-        dem_granules_view g = dem_world_granules(w);
-        dem_diagnostics dg = dem_world_diagnose(w);
-        bad = !h5 || dem_h5_write_frame(h5, dem_world_time(w), &g, &dg) ||
-              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
-        if (h5) bad |= dem_h5_close(h5, err, sizeof err);
-    }
+    if (!bad) bad = exp_result_write_h5(dir, w, err, sizeof err);
     const char *status = st == DEM_OK ? "ok" : "failed";
     if (!bad) {
         char tmp[1300];

@@ -78,8 +78,12 @@ int main(int argc, char **argv)
     exp_drum_run_opts o = cal_drum_run_opts(&d, rpm);
     series s = {0};
     o.on_sample = keep, o.sample_ctx = &s;
-    dem_world *w = exp_drum_fill(&d.fill, NULL, NULL, err, sizeof err);
-    if (!w) return fprintf(stderr, "%s\n", err), 1;
+    dem_world *bed = exp_drum_fill(&d.fill, NULL, NULL, err, sizeof err);
+    if (!bed) return fprintf(stderr, "%s\n", err), 1;
+    // A copy of the settled bed, as the calibration turns one (calib/cal_sim.c; a copy steps to the
+    // same bits as the bed itself, tests/physics/test_clone.c, and did here).
+    dem_world *w = dem_world_clone(bed);
+    if (!w) return fprintf(stderr, "out of memory\n"), 1;
     exp_drum_result r;
     if (exp_drum_rotate(w, &d.def, &o, NULL, NULL, &r) != DEM_OK || !r.steady)
         return fprintf(stderr, "the run failed or was not steady\n"), 1;
@@ -100,7 +104,8 @@ int main(int argc, char **argv)
                csa);
     }
     free(list), free(s.m);
-    dem_world_destroy(w);
+    if (w != bed) dem_world_destroy(w);
+    dem_world_destroy(bed);
     cal_config_free(c);
     return 0;
 }

@@ -21,7 +21,7 @@
 # config.yaml there (calibrate keeps a copy of the config it read) replaces the command's config
 # the same way.
 set -euo pipefail
-source "$(dirname "$0")/random_source.sh"
+source "$(dirname "$0")/verify_common.sh"
 bin=$1 src=$2 results=$3 work=$4 n=${5:-2}
 rm -rf "$work" && mkdir -p "$work/out"
 command=$(sed -n 's/^Command: `\(.*\)`.*/\1/p' "$results/report.md")
@@ -104,14 +104,8 @@ echo "picked at random (SEED=$seed): ${picked[*]}"
 for h in "${picked[@]}"; do rm "$work/out/store/$h.yaml"; done
 run rerun
 [ "$(ran rerun)" = "$n" ] || { echo "FAIL: the rerun ran $(ran rerun) simulations, not $n"; fails=$((fails + 1)); }
-fields='^(key|status|angle_deg|angle_sd_deg|csa_percent|csa_sd_percent|steady|simulated_time_s|dt_s|particle_steps|granules|dt_margin_min|dt_lowered):'
-for h in "${picked[@]}"; do
-  if diff <(grep -E "$fields" "$results/store/$h.yaml") <(grep -E "$fields" "$work/out/store/$h.yaml") > "$work/$h.diff"; then
-    echo "ok   $h reproduced: $(grep -E '^(angle_deg|csa_percent):' "$work/out/store/$h.yaml" | tr '\n' ' ')"
-  else
-    echo "FAIL: $h not reproduced:"; cat "$work/$h.diff"; fails=$((fails + 1))
-  fi
-done
+reproduced "$results/store" "$work/out/store" "$work" "${picked[@]}"
+fails=$((fails + not_reproduced))
 cmp -s "$results/calibrated_parameters.csv" "$work/out/calibrated_parameters.csv" ||
   { echo "FAIL: the table after the reruns differs"; fails=$((fails + 1)); }
 echo "$fails failure(s)"

@@ -9,7 +9,7 @@
 # source's, as the command names it: a tier changed since would change every run's key, and fail.
 #   usage: [SEED=N] verify_twin_data.sh GRANUCAL SOURCE_DIR RESULTS_DIR DATA_STORE WORK_DIR [N]
 set -euo pipefail
-source "$(dirname "$0")/random_source.sh"
+source "$(dirname "$0")/verify_common.sh"
 bin=$1 src=$2 results=$3 store=$4 work=$5 n=${6:-2}
 rm -rf "$work" && mkdir -p "$work/out"
 made=$(sed -n 's/^# Made by: granucal synthesize \(.*\)$/\1/p' "$results/repose_angle.csv")
@@ -37,14 +37,8 @@ fails=0
 ran=$(grep -oE '^\[[^]]*\] (mu_s = [^,]*, mu_r = [^,]*, )?[0-9.]+ rpm, seed [0-9]+: ' "$work/synthesize.log" |
       sed -E 's/mu_s = [^,]*, mu_r = [^,]*, //' | sort -u | wc -l)
 [ "$ran" = "$n" ] || { echo "FAIL: synthesize ran $ran simulations, not the $n removed"; fails=$((fails + 1)); }
-fields='^(key|status|angle_deg|angle_sd_deg|csa_percent|csa_sd_percent|steady|simulated_time_s|dt_s|particle_steps|granules|dt_margin_min|dt_lowered):'
-for h in "${picked[@]}"; do
-  if diff <(grep -E "$fields" "$store/$h.yaml") <(grep -E "$fields" "$work/out/store/$h.yaml") > "$work/$h.diff"; then
-    echo "ok   $h reproduced: $(grep -E '^(angle_deg|csa_percent):' "$work/out/store/$h.yaml" | tr '\n' ' ')"
-  else
-    echo "FAIL: $h not reproduced:"; cat "$work/$h.diff"; fails=$((fails + 1))
-  fi
-done
+reproduced "$store" "$work/out/store" "$work" "${picked[@]}"
+fails=$((fails + not_reproduced))
 for f in repose_angle.csv occupied_area.csv; do
   if diff <(grep -v '^#' "$results/$f") <(grep -v '^#' "$work/out/$f"); then
     echo "ok   $f: the committed data rows, re-derived"
