@@ -5,9 +5,9 @@
 // averaging holds every shorter one as a prefix. This runs one of a calibration's own drum runs (its
 // record's key rebuilt from the config and checked equal to RECORD's: the same simulation), keeps every
 // sample, and prints the angle and CSA that averaging T s after the steady test would have given, for
-// each T of TIMES, beside the record's own values. A key prints μ to 10 digits: give MU_S and MU_R as the
-// search had them (the stage_*.yaml files, simulations.csv has 6 digits) to reproduce the record's bits;
-// the key's digits run the same physics in other bits (results/benchmarks/averaging_ab.md).
+// each T of TIMES, beside the record's own values. A key prints μ to 10 digits: given the key's digits
+// the replay did not reproduce the record's bits; give MU_S and MU_R as the search had them (the
+// stage_*.yaml files; simulations.csv has 6 digits) (results/benchmarks/averaging_ab.md).
 //   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED RECORD.yaml TIMES
 //   (granule stage: the drum lined with granules; BED 0, 1, 2: the tier's beds, seeds config seed + BED;
 //    TIMES e.g. 0,1,2,3,4,6,8)
