@@ -9,23 +9,36 @@
 # same code under ASan (hard cases 219 s on the loaded 2 cores). test_lattice_limit (256 s under
 # ASan) is left to the Release run too: its prestressed lattices step through the explicit and
 # implicit code that test_spin_mode and test_engine_physics run under ASan.
+# Tests run two at a time on a 2-core machine (ctest -j): each test says how many cores it keeps
+# busy (PROCESSORS, tests/CMakeLists.txt), so ctest never asks for more than the machine has.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+jobs=$(nproc)
+# Each phase's wall time, printed at the end (what CI's total is made of).
+phase_start=$(date +%s) phases=""
+phase_done() { local now; now=$(date +%s); phases+="$(printf '%-28s %5d s' "$1" $((now - phase_start)))"$'\n'; phase_start=$now; }
+trap 'printf "run_all.sh phases (wall):\n%s" "$phases"' EXIT
 bash .ci/setup
+phase_done "setup and Release build"
 # Label table3_full (the ci twin made afresh, 15-28 min) is run by hand: CI verifies the committed twin
 # from its stores instead (label table3, below; tests/CMakeLists.txt).
-ctest --test-dir build --output-on-failure -j1 -LE "^(table3|table3_full)$"
+ctest --test-dir build --output-on-failure -j"$jobs" -LE "^(table3|table3_full)$"
+phase_done "Release tests"
 # Table 3 (label table3): the ci tier as a twin experiment, verified from its committed stores
 # (results/twin_ci/README.md), and the standard tier's calibration on the lab data verified from its
 # committed store and compared with Table 3 (results/calibration-standard/README.md; the earlier affine
 # run, results/calibration-standard-affine/, re-derived and compared).
-ctest --test-dir build --output-on-failure -j1 -L "^table3$"
+ctest --test-dir build --output-on-failure -j"$jobs" -L "^table3$"
+phase_done "label table3"
 # Without MPI: OpenMPI's MPI_Init loads components whose thread-local storage crashes
 # LeakSanitizer's tracer at exit (every granucal calibrate under ASan ended in "Tracer caught
 # signal 11", so no leak was ever checked there); no MPI test runs under the sanitizers.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRANUCAL_SANITIZE=ON -DGRANUCAL_MPI=OFF >/dev/null
-cmake --build build-asan -j"$(nproc)" >/dev/null
+cmake --build build-asan -j"$jobs" >/dev/null
+phase_done "sanitizer build"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-asan --output-on-failure -L "unit|physics|stability" -E "^(test_settle|test_lattice_limit)$" -j1
+  ctest --test-dir build-asan --output-on-failure -L "unit|physics|stability" -E "^(test_settle|test_lattice_limit)$" -j"$jobs"
+phase_done "sanitizer tests"
 # 45 s per loader (CSV, YAML): about 2.5 min with the clang build.
 bash tests/fuzz/run_fuzz.sh 45
+phase_done "fuzzing"
