@@ -3,12 +3,13 @@
 // calibration's drum run averages the angle and CSA over the steady test's two windows and then
 // average_time more; its trajectory does not depend on when it will stop, so one run of the longest
 // averaging holds every shorter one as a prefix. This runs one of a calibration's own drum runs (its
-// record's key rebuilt from the config and checked equal to RECORD's: the same simulation), keeps every
+// record found in STORE by the key rebuilt from the config: the same simulation), keeps every
 // sample, and prints the angle and CSA that averaging T s after the steady test would have given, for
-// each T of TIMES, beside the record's own values. A key prints μ to 10 digits: given the key's digits
-// the replay did not reproduce the record's bits; give MU_S and MU_R as the search had them (the
-// stage_*.yaml files; simulations.csv has 6 digits) (results/benchmarks/averaging_ab.md).
-//   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED RECORD.yaml TIMES
+// each T of TIMES, beside the record's own values. A key prints μ to 10 digits, so the record is found
+// from the key's digits too, but only the search's own μ (the stage_*.yaml files, 17 digits;
+// simulations.csv has 6) reproduces its bits: the line "this run ... record" says whether it did
+// (results/benchmarks/averaging_ab.md).
+//   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES
 //   (granule stage: the drum lined with granules; BED 0, 1, 2: the tier's beds, seeds config seed + BED;
 //    TIMES e.g. 0,1,2,3,4,6,8)
 #include <math.h>
@@ -18,6 +19,7 @@
 
 #include "cal_config.h"
 #include "cal_sim.h"
+#include "cal_store.h"
 #include "exp_drum.h"
 
 typedef struct series {
@@ -37,23 +39,6 @@ static void keep(int index, const exp_drum_measure *m, void *ctx)
     s->n = index + 1;
 }
 
-// The record's field NAME as text ("" if absent).
-static void record_field(const char *path, const char *name, char *out, size_t len)
-{
-    out[0] = '\0';
-    FILE *f = fopen(path, "r");
-    char line[4096];
-    size_t n = strlen(name);
-    while (f && fgets(line, sizeof line, f))
-        if (!strncmp(line, name, n) && line[n] == ':') {
-            char *v = line + n + 1;
-            v += strspn(v, " '");
-            v[strcspn(v, "'\n")] = '\0';
-            snprintf(out, len, "%s", v);
-        }
-    if (f) fclose(f);
-}
-
 static void mean_over(const series *s, int from, int to, double *angle, double *csa)
 {
     double a = 0, c = 0;
@@ -64,8 +49,8 @@ static void mean_over(const series *s, int from, int to, double *angle, double *
 int main(int argc, char **argv)
 {
     if (argc != 10)
-        return fprintf(stderr, "usage: %s CONFIG TIER K_N MU_S MU_R RPM BED RECORD.yaml TIMES\n", argv[0]), 2;
-    char err[1024], key[4096], recorded_key[4096], text[64];
+        return fprintf(stderr, "usage: %s CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES\n", argv[0]), 2;
+    char err[1024], key[4096];
     cal_config *c = cal_config_load(argv[1], argv[2], err, sizeof err);
     if (!c) return fprintf(stderr, "%s\n", err), 1;
     const cal_tier *t = cal_config_tier(c);
@@ -73,9 +58,10 @@ int main(int argc, char **argv)
     cal_drum_case d = cal_drum_case_granule(c, t, atof(argv[3]), atof(argv[4]), atof(argv[5]));
     d.def.seed = d.fill.seed = (uint64_t)(c->seed + atoi(argv[7])); // as the friction stage sets a bed's seed
     cal_drum_key(&d, rpm, key, sizeof key);
-    record_field(argv[8], "key", recorded_key, sizeof recorded_key);
-    if (strcmp(key, recorded_key))
-        return fprintf(stderr, "not the record's simulation:\n  built  %s\n  record %s\n", key, recorded_key), 1;
+    cal_record rec;
+    const int got = cal_store_get(argv[8], key, &rec, err, sizeof err);
+    if (got != 0)
+        return fprintf(stderr, "%s: %s\n  key %s\n", argv[8], got > 0 ? "no record of this simulation" : err, key), 1;
     exp_drum_run_opts o = cal_drum_run_opts(&d, rpm);
     series s = {0};
     o.on_sample = keep, o.sample_ctx = &s;
@@ -90,11 +76,11 @@ int main(int argc, char **argv)
         return fprintf(stderr, "the run failed or was not steady\n"), 1;
     int per_window = (int)(o.window / o.sample_interval + 0.5), avg = (int)(o.average_time / o.sample_interval + 0.5);
     int steady_at = s.n - avg, from = steady_at - 2 * per_window;
-    record_field(argv[8], "angle_deg", text, sizeof text);
-    printf("record %s: angle %s", argv[8], text);
-    record_field(argv[8], "csa_percent", text, sizeof text);
-    printf(", CSA %s; this run: angle %.17g, CSA %.17g; steady test held at %.2f s of turning\n", text, r.angle_deg,
-           r.csa_percent, steady_at * o.sample_interval);
+    const int same = rec.angle_deg == r.angle_deg && rec.csa_percent == r.csa_percent;
+    printf("record: angle %.17g, CSA %.17g; this run: angle %.17g, CSA %.17g (%s the record); steady test held at "
+           "%.2f s of turning\n",
+           rec.angle_deg, rec.csa_percent, r.angle_deg, r.csa_percent, same ? "reproduces" : "does NOT reproduce",
+           steady_at * o.sample_interval);
     char *list = strdup(argv[9]), *save = NULL;
     for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         double T = atof(tok), angle, csa;
@@ -105,6 +91,7 @@ int main(int argc, char **argv)
                csa);
     }
     free(list), free(s.m);
+    cal_record_free(&rec);
     if (w != bed) dem_world_destroy(w);
     dem_world_destroy(bed);
     cal_config_free(c);

@@ -22,6 +22,13 @@
 #   --ceiling only what two cores give this machine at N = 100 000: granucal
 #             on 1 thread alone, two such processes at once (the most 2 threads
 #             could reach here), and 2 threads; R rounds (ceiling.csv)
+#   --turning-scan only the step each code keeps the turning drum at (issue 37.3): the N = 5 000
+#             bed turned at 40 rpm, 1 s of spin-up then 2 s of frames, at 0.1, 0.2, 0.3,
+#             0.45 and 0.6 dt_crit (and granucal at its own network step), each frame
+#             measured with granucal's raster; a step counts where the angle and CSA lie
+#             within 2 standard errors of that code's own 0.1 dt_crit run
+#             (turning_scan.csv). A later full run in the same --out takes each
+#             code's step for its wall time per simulated second from that file.
 #   GRANUCAL_WAIT=default|passive|active (environment): how granucal's threads
 #             wait at a barrier in the main runs (default: OMP_WAIT_POLICY unset)
 #
@@ -35,7 +42,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=${BUILD:-$ROOT/build-bench}
 ARGS="$*"
-QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0 LEVERS=0 FLATNESS=0 CEILING=0
+QUICK=0 REPS=3 SCALE=1 OUT="" REBUILD=0 WORKTREE=0 LEVERS=0 FLATNESS=0 CEILING=0 TURNING=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) QUICK=1; REPS=2 ;;
@@ -47,7 +54,8 @@ while [ $# -gt 0 ]; do
     --levers) LEVERS=1 ;;
     --flatness) FLATNESS=1 ;;
     --ceiling) CEILING=1 ;;
-    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
+    --turning-scan) TURNING=1 ;;
+    -h|--help) sed -n '2,36p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -110,6 +118,7 @@ RAW=$OUT/raw.csv LOG=$OUT/runs.log
 [ $LEVERS -eq 1 ] && RAW=$OUT/levers.csv LOG=$OUT/levers.log
 [ $FLATNESS -eq 1 ] && RAW=$OUT/flat.csv LOG=$OUT/flat.log
 [ $CEILING -eq 1 ] && RAW=/dev/null LOG=$OUT/ceiling.log # the pass writes ceiling.csv itself
+[ $TURNING -eq 1 ] && RAW=$OUT/turning_runs.csv LOG=$OUT/turning.log
 echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
 : > "$LOG"
 
@@ -143,12 +152,13 @@ relabel_last() {
   sed -i "\$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,$1,/" "$RAW"
 }
 
-# run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO
+# run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO [-var NAME VALUE ...]
 run_peer() {
   local code=$1 n=$2 np=$3 rep=$4 steps=$5 dt=$6 omega=$7 nthermo=$8
+  shift 8
   local log=$OUT/${code}_${n}_${np}_${rep}.log tf=$OUT/time.txt status=ok
   local common=(-var data "$BEDS/drum_$n.data" -var dt "$dt" -var steps "$steps" -var nthermo "$nthermo"
-                -var rdrum "$(vars "$n" RDRUM)" -var omega "$omega" -var skin "$(vars "$n" SKIN)")
+                -var rdrum "$(vars "$n" RDRUM)" -var omega "$omega" -var skin "$(vars "$n" SKIN)" "$@")
   if [ "$code" = liggghts ]; then
     /usr/bin/time -f "%M" -o "$tf" "${MPIRUN[@]}" -np "$np" liggghts -in "$PEERS/drum_liggghts.in" -echo none -screen none \
       -log "$log" "${common[@]}" -var coeffs "$BEDS/drum_$n.liggghts.coeffs" >>"$LOG" 2>&1 || status=failed
@@ -279,6 +289,77 @@ for n in sorted({int(r['N']) for r in rows}):
     print("%7d %16.3e %16.3e %8.2f" % (n, st.median(a.values()), st.median(m.values()),
                                        st.median([m[k] / a[k] for k in a if k in m])))
 EOF
+  exit 0
+fi
+
+# ---- the step each code keeps the turning drum at (issue 37.3). A step counts for a code where its
+# drum reads the angle and CSA of its own smallest step (0.1 dt_crit), within 2 standard errors of the
+# difference (batch means of 0.25 s over the 2 s of frames: one bed, so this is the spread of a
+# 2 s average, not of beds), and so does every smaller step. Each code is judged against itself: the
+# scan asks which step a code can take without changing its own answer, not whether the codes agree
+# (tests/peers/ does that, on the exported decks).
+TURN_RPM=40 TURN_SPINUP=1.0 TURN_MEASURE=2.0 TURN_FACTORS="0.1 0.2 0.3 0.45 0.6"
+turn_steps() { python3 -c "print(max(1, int(round($1 / $2))))"; } # SECONDS DT
+turning_scan() {
+  local csv=$OUT/turning_scan.csv data=$BEDS/drum_$N0.data omega line dt every dump
+  omega=$(python3 -c "import math; print($TURN_RPM * math.pi / 30)")
+  echo "code,N,dt,angle_deg,angle_se,csa_pct,csa_se,frames,status,factor" > "$csv"
+  for f in $TURN_FACTORS net; do
+    if [ $f = net ]; then dt=0; else dt=$(python3 -c "print('%.6g' % ($f * $DTC))"); fi
+    echo "turning scan: granucal at $f dt_crit" >&2
+    line=$(OMP_NUM_THREADS=1 "$BENCH" turn "$data" "$dt" $TURN_RPM $TURN_SPINUP $TURN_MEASURE allow 2>>"$LOG") ||
+      line=${line:-granucal,$N0,$dt,,,,,0,failed}
+    [ $f = net ] && f=$(python3 -c "print('%.4g' % ($(echo "$line" | cut -d, -f3) / $DTC))")
+    echo "$line,$f" >> "$csv"
+    [ "$dt" = 0 ] && continue
+    every=$(turn_steps 0.05 "$dt")
+    for code in liggghts lammps; do
+      echo "turning scan: $code at $f dt_crit" >&2
+      dump=$OUT/${code}_turn_$f.dump
+      rm -f "$dump"
+      run_peer $code $N0 1 "turn$f" $((every * $(turn_steps $TURN_MEASURE 0.05))) "$dt" "$omega" "$every" \
+        -var spinup "$(turn_steps $TURN_SPINUP "$dt")" -var dumpevery "$every" -var dumpfile "$dump"
+      line=$("$BENCH" measure $code "$data" "$dump" "$dt" 2>>"$LOG") || line=${line:-$code,$N0,$dt,,,,,0,failed}
+      echo "$line,$f" >> "$csv"
+      rm -f "$dump"
+    done
+  done
+  turning_table "$csv"
+}
+
+# turning_table CSV: each run against its code's smallest step, and the largest step that, with every
+# smaller one, reads the same drum (printed as `turning_step CODE FACTOR`).
+turning_table() {
+  python3 - "$1" <<'EOF'
+import csv, math, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1]))]
+num = lambda x: float(x) if x not in ('', 'nan', '-nan') else float('nan')
+print("\n== the turning drum (N = 5000, 40 rpm, 2 s of frames after 1 s): mean angle and CSA +- standard error")
+for code in ('granucal', 'liggghts', 'lammps'):
+    rs = sorted([r for r in rows if r['code'] == code], key=lambda r: float(r['factor']))
+    ok = [r for r in rs if r['status'] == 'ok' and int(r['frames']) > 1]
+    if not ok:
+        print("  %-9s no run measured" % code); continue
+    ref = ok[0]
+    a0, sa0, c0, sc0 = (num(ref[k]) for k in ('angle_deg', 'angle_se', 'csa_pct', 'csa_se'))
+    chosen, broken = float(ref['factor']), False
+    for r in rs:
+        f = float(r['factor'])
+        if r['status'] != 'ok' or int(r['frames']) <= 1:
+            print("  %-9s %.3f dt_crit: %s" % (code, f, r['status'])); broken = True; continue
+        a, sa, c, sc = (num(r[k]) for k in ('angle_deg', 'angle_se', 'csa_pct', 'csa_se'))
+        same = abs(a - a0) <= 2 * math.hypot(sa, sa0) and abs(c - c0) <= 2 * math.hypot(sc, sc0)
+        if r is not ref and not same: broken = True
+        if r is not ref and same and not broken: chosen = max(chosen, f)
+        print("  %-9s %.3f dt_crit: angle %6.2f +- %.2f deg, CSA %6.2f +- %.2f %% (%s frames)%s" % (
+            code, f, a, sa, c, sc, r['frames'], "  reference" if r is ref else
+            "  diff %+.2f deg %+.2f pts: %s" % (a - a0, c - c0, "same drum" if same else "NOT the same drum")))
+    print("turning_step %s %.4g" % (code, chosen))
+EOF
+}
+
+if [ $TURNING -eq 1 ]; then
+  turning_scan
   exit 0
 fi
 
