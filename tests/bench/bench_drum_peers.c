@@ -12,12 +12,6 @@
 //       and OUTDIR/drum_N.vars (shell: λ, depth, dt_crit, granucal's steps).
 //   bench_drum_peers tile DATA OUTDIR TILES...
 //       The bed of DATA repeated TILES times along the axis, written like build.
-//   bench_drum_peers turn DATA DT RPM SPINUP MEASURE [allow]
-//       Turns DATA's bed at RPM on one thread, SPINUP s, then measures a frame every 0.05 s for
-//       MEASURE s; prints code,N,dt,angle_deg,angle_se,csa_pct,csa_se,frames,status (means over
-//       the frames, standard errors by batch means).
-//   bench_drum_peers measure CODE DATA DUMP DT
-//       The same line for a peer's dump (id type x y z vx vy vz radius) of DATA's bed.
 //   bench_drum_peers run DATA STEPS THREADS VARIANT DT [RPM [allow]]   (DT 0: the engine's network step)
 //       Reads DATA, builds the drum at the real parameters (VARIANT: all,
 //       norolling, notangential: granules sorted by dem_world_sort_spatially;
@@ -554,123 +548,6 @@ static int cmd_run(const char *data, long steps, int threads, const char *varian
     return st == DEM_OK ? 0 : 3;
 }
 
-// ---------------------------------------------------------------- turn and measure (issue 37.3)
-// Which step reproduces the turning drum: each code turns the same bed at the same speed, and the
-// angle and CSA averaged over the frames after a spin-up are compared with that code's own
-// smallest-step run (tests/bench/vs_peers.sh --turning-scan). Frames every SAMPLE_S, as the
-// calibration's drum samples (exp_drum's sample_interval).
-#define SAMPLE_S 0.05
-#define BATCH_FRAMES 5 // 0.25 s a batch: longer than an avalanche's passage at 40 rpm
-
-// The mean of x[0..n) and its standard error by batch means (consecutive frames are correlated, so
-// the frames' own spread over sqrt(n) would claim too much).
-static void batch_mean(const double *x, int n, double *mean, double *se)
-{
-    const int nb = n / BATCH_FRAMES;
-    double sum = 0, b[4096], bm = 0, var = 0;
-    for (int i = 0; i < n; ++i) sum += x[i];
-    *mean = n > 0 ? sum / n : NAN;
-    for (int k = 0; k < nb && k < 4096; ++k) {
-        b[k] = 0;
-        for (int i = 0; i < BATCH_FRAMES; ++i) b[k] += x[k * BATCH_FRAMES + i] / BATCH_FRAMES;
-        bm += b[k] / nb;
-    }
-    for (int k = 0; k < nb && k < 4096; ++k) var += (b[k] - bm) * (b[k] - bm) / (nb - 1);
-    *se = nb > 1 ? sqrt(var / nb) : NAN;
-}
-
-typedef struct frames {
-    int n;
-    double angle[4096], csa[4096];
-} frames;
-
-static void keep_frame(frames *fr, const exp_drum_measure *m)
-{
-    if (fr->n < 4096 && m->angle_deg == m->angle_deg) fr->angle[fr->n] = m->angle_deg, fr->csa[fr->n++] = m->csa_percent;
-}
-
-// One line: code,N,dt,angle_deg,angle_se,csa_pct,csa_se,frames,status
-static void print_frames(const char *code, size_t n, double dt, const frames *fr, const char *status)
-{
-    double a, ase, c, cse;
-    batch_mean(fr->angle, fr->n, &a, &ase);
-    batch_mean(fr->csa, fr->n, &c, &cse);
-    printf("%s,%zu,%.6g,%.3f,%.3f,%.3f,%.3f,%d,%s\n", code, n, dt, a, ase, c, cse, fr->n, status);
-}
-
-// Turns DATA's bed at RPM with a step of DT (0: the engine's network step) for SPINUP s, then
-// measures a frame every SAMPLE_S for MEASURE s.
-static int cmd_turn(const char *data, double dt, double rpm, double spinup, double measure_s, int allow)
-{
-    scene s;
-    dem_world *w = read_data(data, &s, dt, 1, NULL, allow);
-    if (!w) return 1;
-    if (dem_world_sort_spatially(w) != DEM_OK) return fprintf(stderr, "%s\n", dem_world_error(w)), 1;
-    dem_status st = dt > 0 ? dem_world_prepare(w) : dem_world_adopt_network_dt(w);
-    if (st != DEM_OK) return fprintf(stderr, "%s\n", dem_world_error(w)), 1;
-    fprintf(stderr, "%s\n", dem_world_dt_report(w));
-    dem_world_set_wall_spin(w, 0, rpm * 2 * DEM_PI / 60);
-    const double step = dem_world_dt(w);
-    const uint64_t per_frame = (uint64_t)(SAMPLE_S / step + 0.5);
-    st = dem_world_step(w, (uint64_t)(spinup / step + 0.5));
-    static frames fr;
-    for (int k = 0; st == DEM_OK && k < (int)(measure_s / SAMPLE_S + 0.5); ++k) {
-        st = dem_world_step(w, per_frame);
-        exp_drum_measure m;
-        measure(w, &s, &m);
-        keep_frame(&fr, &m);
-    }
-    print_frames("granucal", dem_world_granules(w).count, step, &fr, st == DEM_OK ? "ok" : dem_world_error(w));
-    dem_world_destroy(w);
-    return st == DEM_OK ? 0 : 3;
-}
-
-// Reads one frame of a LAMMPS/LIGGGHTS `dump custom ... id type x y z vx vy vz radius` into a world
-// of DATA's scene (positions and radii only: the raster needs nothing else). 0 at the end of the file.
-static dem_world *read_dump_frame(FILE *f, const scene *s)
-{
-    char line[512];
-    long count = -1;
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "ITEM: NUMBER OF ATOMS", 21)) {
-            if (!fgets(line, sizeof line, f)) return NULL;
-            count = atol(line);
-        } else if (!strncmp(line, "ITEM: ATOMS", 11)) break;
-    if (count < 0) return NULL;
-    dem_world *w = create_world(s, &s->gg, &s->gw, 0, 1, 0, 0);
-    const double rho = dem_scale_density(s->drum.density, s->lambda);
-    for (long i = 0; i < count && fgets(line, sizeof line, f); ++i) {
-        double x, y, z, v[3], r;
-        long id;
-        int type;
-        if (sscanf(line, "%ld %d %lf %lf %lf %lf %lf %lf %lf", &id, &type, &x, &y, &z, &v[0], &v[1], &v[2], &r) == 9)
-            dem_world_add_granule(w, dem_v3(x, y, z), dem_v3(0, 0, 0), dem_v3(0, 0, 0), r, rho);
-    }
-    return w;
-}
-
-// Every frame of a peer's DUMP measured with granucal's raster on DATA's drum.
-static int cmd_measure(const char *code, const char *data, const char *dump, double dt)
-{
-    scene s;
-    dem_world *bed = read_data(data, &s, 0, 1, NULL, 0);
-    FILE *f = fopen(dump, "r");
-    if (!bed || !f) return fprintf(stderr, "cannot read %s or %s\n", data, dump), 1;
-    static frames fr;
-    size_t n = 0;
-    for (dem_world *w; (w = read_dump_frame(f, &s));) {
-        exp_drum_measure m;
-        measure(w, &s, &m);
-        keep_frame(&fr, &m);
-        n = dem_world_granules(w).count;
-        dem_world_destroy(w);
-    }
-    fclose(f);
-    dem_world_destroy(bed);
-    print_frames(code, n, dt, &fr, fr.n > 1 ? "ok" : "no frames");
-    return fr.n > 1 ? 0 : 3;
-}
-
 int main(int argc, char **argv)
 {
     if (argc >= 4 && strcmp(argv[1], "build") == 0) return cmd_build(atoi(argv[2]), argv[3], argc - 4, argv + 4);
@@ -678,13 +555,9 @@ int main(int argc, char **argv)
     if (argc >= 7 && strcmp(argv[1], "run") == 0)
         return cmd_run(argv[2], atol(argv[3]), atoi(argv[4]), argv[5], atof(argv[6]), argc > 7 ? atof(argv[7]) : 40,
                        argc > 8 && strcmp(argv[8], "allow") == 0);
-    if (argc >= 7 && strcmp(argv[1], "turn") == 0)
-        return cmd_turn(argv[2], atof(argv[3]), atof(argv[4]), atof(argv[5]), atof(argv[6]),
-                        argc > 7 && strcmp(argv[7], "allow") == 0);
-    if (argc == 6 && strcmp(argv[1], "measure") == 0) return cmd_measure(argv[2], argv[3], argv[4], atof(argv[5]));
     if (argc >= 2 && strcmp(argv[1], "header") == 0) return puts(HEADER), 0;
     fprintf(stderr,
-            "usage: %s build N OUTDIR [TILES...] | tile DATA OUTDIR TILES... | run DATA STEPS THREADS all|norolling|notangential|unsorted DT [RPM [allow]] | turn DATA DT RPM SPINUP MEASURE [allow] | measure CODE DATA DUMP DT | header\n",
+            "usage: %s build N OUTDIR [TILES...] | tile DATA OUTDIR TILES... | run DATA STEPS THREADS all|norolling|notangential|unsorted DT [RPM [allow]] | header\n",
             argv[0]);
     return 2;
 }

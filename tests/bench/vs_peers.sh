@@ -22,13 +22,13 @@
 #   --ceiling only what two cores give this machine at N = 100 000: granucal
 #             on 1 thread alone, two such processes at once (the most 2 threads
 #             could reach here), and 2 threads; R rounds (ceiling.csv)
-#   --turning-scan only the step each code keeps the turning drum at (issue 37.3): the N = 5 000
-#             bed turned at 40 rpm, 1 s of spin-up then 2 s of frames, at 0.1, 0.2, 0.3,
-#             0.45 and 0.6 dt_crit (and granucal at its own network step), each frame
-#             measured with granucal's raster; a step counts where the angle and CSA lie
-#             within 2 standard errors of that code's own 0.1 dt_crit run
-#             (turning_scan.csv). A later full run in the same --out takes each
-#             code's step for its wall time per simulated second from that file.
+#   --turning-scan only the step each peer can take on the turning drum (issue 37.3): the
+#             decks a calibration exports (the committed ci twin's, as tests/peers/drum_peers.sh
+#             runs them) turned at 40 rpm at 0.1, 0.1651, 0.3, 0.45 and 0.6 dt_crit, with
+#             granucal on its own step beside them; a peer's step counts where its answer
+#             stays within the peers test's tolerance of its own smallest step
+#             (turning_steps.txt). A later full run in the same --out takes each peer's
+#             step from that file for its wall time per simulated second.
 #   GRANUCAL_WAIT=default|passive|active (environment): how granucal's threads
 #             wait at a barrier in the main runs (default: OMP_WAIT_POLICY unset)
 #
@@ -94,11 +94,65 @@ else
   rm -rf "$SRC" && mkdir -p "$SRC"
   git -C "$ROOT" archive HEAD | tar -x -C "$SRC"
   cp "$ROOT/tests/bench/bench_drum_peers.c" "$SRC/tests/bench/"
+  cp "$ROOT/tests/peers/drum_peers.sh" "$SRC/tests/peers/" # the turning scan's driver, as edited
   GRANUCAL_SRC="git archive HEAD + work-tree bench_drum_peers.c$(git -C "$ROOT" diff --quiet HEAD -- tests/bench/bench_drum_peers.c 2>/dev/null || echo ' (modified)')"
 fi
 cmake -S "$SRC" -B "$OBJ" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$OBJ" -j2 --target bench_drum_peers >/dev/null
 BENCH=$OBJ/tests/bench_drum_peers
+
+# ---- the step each peer can take on the turning drum (issue 37.3). The decks a calibration exports
+# (the committed ci twin's, as the peers test runs them: tests/peers/drum_peers.sh) turned at 40 rpm at
+# each fraction of dt_crit in TURN_FACTORS, granucal beside them on its own step (3 seeds). A step
+# counts for a peer where its angle and CSA stay within the peers test's tolerance (3 x the larger of
+# granucal's seed SD there and the ci tier's 40 rpm SD) of that peer's own smallest step, and so do
+# those of every smaller step: the step it can take without changing its own answer. The wall time per
+# simulated second then uses that step (the main run, same --out).
+TURN_FACTORS="0.1 0.1651 0.3 0.45 0.6"
+turning_scan() {
+  cmake --build "$OBJ" -j2 --target granucal drum_peers >/dev/null
+  for f in $TURN_FACTORS; do
+    echo "turning scan: the decks at $f dt_crit" >&2
+    DT_FRACTION=$f bash "$SRC/tests/peers/drum_peers.sh" "$OBJ/granucal" "$OBJ/tests/drum_peers" "$OUT/turn_$f" \
+      > "$OUT/turn_$f.txt" 2>&1 || true # exit 1: a peer away from granucal, which is what the scan measures
+    rm -f "$OUT/turn_$f"/*/*.dump
+  done
+  python3 - "$OUT" $TURN_FACTORS <<'EOF' | tee "$OUT/turning_steps.txt"
+import csv, os, sys
+out, factors = sys.argv[1], sys.argv[2:]
+rows = {}
+for f in factors:
+    path = os.path.join(out, 'turn_' + f, 'peers.csv')
+    if os.path.exists(path):
+        rows[f] = {r['code']: r for r in csv.DictReader(open(path))}
+num = lambda x: float(x) if x not in ('', 'nan', '-nan') else float('nan')
+print("== the exported decks turned at 40 rpm: angle (deg) and CSA (%) at each peer step (fraction of dt_crit)")
+g = next(iter(rows.values()), {}).get('granucal')
+if g: print("  granucal on its own step: %.2f sd %.2f deg, %.2f sd %.2f %% (3 seeds)" % tuple(num(g[k]) for k in
+          ('angle_deg', 'angle_sd', 'csa_pct', 'csa_sd')))
+for code in ('liggghts', 'lammps'):
+    runs = [(float(f), rows[f][code], rows[f]['tolerance']) for f in factors if f in rows and code in rows[f]]
+    if not runs:
+        print("turning_step %s none (no run measured)" % code); continue
+    f0, ref, _ = runs[0]
+    chosen, broken = f0, False
+    for f, r, tol in runs:
+        da, dc = num(r['angle_deg']) - num(ref['angle_deg']), num(r['csa_pct']) - num(ref['csa_pct'])
+        same = abs(da) <= num(tol['angle_deg']) and abs(dc) <= num(tol['csa_pct'])
+        broken |= not same
+        if not broken: chosen = f
+        gd = num(r['angle_deg']) - num(g['angle_deg']) if g else float('nan')
+        print("  %-9s %.4g dt_crit: %6.2f deg, %6.2f %%; from its %.4g dt_crit run %+.2f deg %+.2f pts (tolerance %s, %s): %s;"
+              " from granucal %+.2f deg" % (code, f, num(r['angle_deg']), num(r['csa_pct']), f0, da, dc,
+                                             tol['angle_deg'], tol['csa_pct'], "same drum" if same else "NOT the same drum", gd))
+    print("turning_step %s %.4g" % (code, chosen))
+EOF
+}
+
+if [ $TURNING -eq 1 ]; then
+  mkdir -p "$OUT" && turning_scan
+  exit 0
+fi
 
 # ---- settled beds: N = 5 000 settled once; 20 000 and 100 000 are the same
 # periodic slab repeated 4 and 20 times along the drum axis (same λ, same step).
@@ -118,7 +172,6 @@ RAW=$OUT/raw.csv LOG=$OUT/runs.log
 [ $LEVERS -eq 1 ] && RAW=$OUT/levers.csv LOG=$OUT/levers.log
 [ $FLATNESS -eq 1 ] && RAW=$OUT/flat.csv LOG=$OUT/flat.log
 [ $CEILING -eq 1 ] && RAW=/dev/null LOG=$OUT/ceiling.log # the pass writes ceiling.csv itself
-[ $TURNING -eq 1 ] && RAW=$OUT/turning_runs.csv LOG=$OUT/turning.log
 echo "code,N,threads,rep,variant,steps,dt,loop_s,psps,maxrss_kib,status,angle0,csa0,angle1,csa1,checksum,ke_end" > "$RAW"
 : > "$LOG"
 
@@ -152,13 +205,12 @@ relabel_last() {
   sed -i "\$ s/^granucal,\([^,]*\),\([^,]*\),\([^,]*\),all,/granucal,\1,\2,\3,$1,/" "$RAW"
 }
 
-# run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO [-var NAME VALUE ...]
+# run_peer CODE N RANKS REP STEPS DT OMEGA NTHERMO
 run_peer() {
   local code=$1 n=$2 np=$3 rep=$4 steps=$5 dt=$6 omega=$7 nthermo=$8
-  shift 8
   local log=$OUT/${code}_${n}_${np}_${rep}.log tf=$OUT/time.txt status=ok
   local common=(-var data "$BEDS/drum_$n.data" -var dt "$dt" -var steps "$steps" -var nthermo "$nthermo"
-                -var rdrum "$(vars "$n" RDRUM)" -var omega "$omega" -var skin "$(vars "$n" SKIN)" "$@")
+                -var rdrum "$(vars "$n" RDRUM)" -var omega "$omega" -var skin "$(vars "$n" SKIN)")
   if [ "$code" = liggghts ]; then
     /usr/bin/time -f "%M" -o "$tf" "${MPIRUN[@]}" -np "$np" liggghts -in "$PEERS/drum_liggghts.in" -echo none -screen none \
       -log "$log" "${common[@]}" -var coeffs "$BEDS/drum_$n.liggghts.coeffs" >>"$LOG" 2>&1 || status=failed
@@ -292,77 +344,6 @@ EOF
   exit 0
 fi
 
-# ---- the step each code keeps the turning drum at (issue 37.3). A step counts for a code where its
-# drum reads the angle and CSA of its own smallest step (0.1 dt_crit), within 2 standard errors of the
-# difference (batch means of 0.25 s over the 2 s of frames: one bed, so this is the spread of a
-# 2 s average, not of beds), and so does every smaller step. Each code is judged against itself: the
-# scan asks which step a code can take without changing its own answer, not whether the codes agree
-# (tests/peers/ does that, on the exported decks).
-TURN_RPM=40 TURN_SPINUP=1.0 TURN_MEASURE=2.0 TURN_FACTORS="0.1 0.2 0.3 0.45 0.6"
-turn_steps() { python3 -c "print(max(1, int(round($1 / $2))))"; } # SECONDS DT
-turning_scan() {
-  local csv=$OUT/turning_scan.csv data=$BEDS/drum_$N0.data omega line dt every dump
-  omega=$(python3 -c "import math; print($TURN_RPM * math.pi / 30)")
-  echo "code,N,dt,angle_deg,angle_se,csa_pct,csa_se,frames,status,factor" > "$csv"
-  for f in $TURN_FACTORS net; do
-    if [ $f = net ]; then dt=0; else dt=$(python3 -c "print('%.6g' % ($f * $DTC))"); fi
-    echo "turning scan: granucal at $f dt_crit" >&2
-    line=$(OMP_NUM_THREADS=1 "$BENCH" turn "$data" "$dt" $TURN_RPM $TURN_SPINUP $TURN_MEASURE allow 2>>"$LOG") ||
-      line=${line:-granucal,$N0,$dt,,,,,0,failed}
-    [ $f = net ] && f=$(python3 -c "print('%.4g' % ($(echo "$line" | cut -d, -f3) / $DTC))")
-    echo "$line,$f" >> "$csv"
-    [ "$dt" = 0 ] && continue
-    every=$(turn_steps 0.05 "$dt")
-    for code in liggghts lammps; do
-      echo "turning scan: $code at $f dt_crit" >&2
-      dump=$OUT/${code}_turn_$f.dump
-      rm -f "$dump"
-      run_peer $code $N0 1 "turn$f" $((every * $(turn_steps $TURN_MEASURE 0.05))) "$dt" "$omega" "$every" \
-        -var spinup "$(turn_steps $TURN_SPINUP "$dt")" -var dumpevery "$every" -var dumpfile "$dump"
-      line=$("$BENCH" measure $code "$data" "$dump" "$dt" 2>>"$LOG") || line=${line:-$code,$N0,$dt,,,,,0,failed}
-      echo "$line,$f" >> "$csv"
-      rm -f "$dump"
-    done
-  done
-  turning_table "$csv"
-}
-
-# turning_table CSV: each run against its code's smallest step, and the largest step that, with every
-# smaller one, reads the same drum (printed as `turning_step CODE FACTOR`).
-turning_table() {
-  python3 - "$1" <<'EOF'
-import csv, math, sys
-rows = [r for r in csv.DictReader(open(sys.argv[1]))]
-num = lambda x: float(x) if x not in ('', 'nan', '-nan') else float('nan')
-print("\n== the turning drum (N = 5000, 40 rpm, 2 s of frames after 1 s): mean angle and CSA +- standard error")
-for code in ('granucal', 'liggghts', 'lammps'):
-    rs = sorted([r for r in rows if r['code'] == code], key=lambda r: float(r['factor']))
-    ok = [r for r in rs if r['status'] == 'ok' and int(r['frames']) > 1]
-    if not ok:
-        print("  %-9s no run measured" % code); continue
-    ref = ok[0]
-    a0, sa0, c0, sc0 = (num(ref[k]) for k in ('angle_deg', 'angle_se', 'csa_pct', 'csa_se'))
-    chosen, broken = float(ref['factor']), False
-    for r in rs:
-        f = float(r['factor'])
-        if r['status'] != 'ok' or int(r['frames']) <= 1:
-            print("  %-9s %.3f dt_crit: %s" % (code, f, r['status'])); broken = True; continue
-        a, sa, c, sc = (num(r[k]) for k in ('angle_deg', 'angle_se', 'csa_pct', 'csa_se'))
-        same = abs(a - a0) <= 2 * math.hypot(sa, sa0) and abs(c - c0) <= 2 * math.hypot(sc, sc0)
-        if r is not ref and not same: broken = True
-        if r is not ref and same and not broken: chosen = max(chosen, f)
-        print("  %-9s %.3f dt_crit: angle %6.2f +- %.2f deg, CSA %6.2f +- %.2f %% (%s frames)%s" % (
-            code, f, a, sa, c, sc, r['frames'], "  reference" if r is ref else
-            "  diff %+.2f deg %+.2f pts: %s" % (a - a0, c - c0, "same drum" if same else "NOT the same drum")))
-    print("turning_step %s %.4g" % (code, chosen))
-EOF
-}
-
-if [ $TURNING -eq 1 ]; then
-  turning_scan
-  exit 0
-fi
-
 # ---- 1. largest step each code keeps a dense bed at rest (N = 5 000, drum still)
 # A step is kept if the run completes, nothing is lost and the kinetic energy
 # at the end is below 1e-3 of (bed mass)·g·d50 (the bed was built at rest).
@@ -434,10 +415,15 @@ flatness_pass "$DT"
 flatness_table "$RAW"
 
 # ---- 3. table, 1 s of drum, accuracy guard, final line
-python3 - "$RAW" "$BEDS" "$DTC" "$DT_NET" "$BEDMASS" "$D50" <<'EOF'
-import csv, statistics as st, sys
+python3 - "$RAW" "$BEDS" "$DTC" "$DT_NET" "$BEDMASS" "$D50" "$OUT/turning_steps.txt" <<'EOF'
+import csv, os, statistics as st, sys
 raw, beds = sys.argv[1], sys.argv[2]
-dtc, dtnet, mass, d50 = map(float, sys.argv[3:])
+dtc, dtnet, mass, d50 = map(float, sys.argv[3:7])
+turning = {}  # each peer's step on the turning drum (--turning-scan), where it was measured
+if os.path.exists(sys.argv[7]):
+    for line in open(sys.argv[7]):
+        w = line.split()
+        if len(w) == 3 and w[0] == 'turning_step' and w[2] != 'none': turning[w[1]] = float(w[2])
 rows = list(csv.DictReader(open(raw)))
 med = lambda xs: st.median(xs) if xs else float('nan')
 def sel(**kw): return [r for r in rows if all(r[k] == v for k, v in kw.items())]
@@ -501,10 +487,13 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'
                   "(median %.2f)" % (n, label, med(list(two.values())), med(list(one.values())),
                                      ", ".join("%.2f" % x for x in pairs), med(pairs)))
 
-print("\n== wall time to simulate 1 s of the drum at N = 20000, at each code's largest step kept at rest")
+# A peer's step: the largest that keeps its turning drum's answer (--turning-scan, turning_steps.txt),
+# else the largest that keeps a bed at rest (flatters a peer: LIGGGHTS' drum fluidises at 0.6).
+basis = "its turning drum's answer (turning_steps.txt)" if turning else "a bed at rest (no turning scan in this --out)"
+print("\n== wall time to simulate 1 s of the drum at N = 20000; a peer's step: the largest that keeps " + basis)
 for th in ('1', '2'):
     for code in ('granucal', 'liggghts', 'lammps'):
-        ps = summary.get((code, 20000, th)); f = scan.get(code)
+        ps = summary.get((code, 20000, th)); f = turning.get(code, scan.get(code))
         if code == 'granucal': f = dtnet / dtc  # the engine's own pick (network step)
         if ps and f:
             print("  %-9s %s thr: dt = %.3f dt_crit -> %.0f s per simulated second" % (code, th, f, 20000 / (f * dtc) / ps))

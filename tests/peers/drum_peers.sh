@@ -16,6 +16,8 @@
 # these -var overrides only:
 #   rpm 40       (the deck's default is the tier's first speed, 4 rpm)
 #   measure 2.0  (s dumped; the deck's default is the tier's 4 s less its 1 s spinup)
+#   dt_fraction  only where DT_FRACTION is set (the deck's default: granucal's a-priori step;
+#                tests/bench/vs_peers.sh --turning-scan sets it to find the step each peer can take)
 # The scene: the deck's drum (lambda, slice depth, fill, GSD as the deck says),
 # lined with its lining 1 (aluminium), 40 rpm.
 #  - granucal: `granucal simulate` of configs/drum.yaml at the deck's lambda and
@@ -91,7 +93,9 @@ sets=(--set lambda="$lambda" --set slice_depth="$depth" --set max_time=4.0 --set
 # 3. The peers, side by side (one core each), while granucal waits.
 run_peer() { # CODE EXE DECK
   rm -rf "$1" && mkdir "$1" && cp "$export_dir"/*.in "$1/"
-  (cd "$1" && { time nice $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" -log $1.log > $1.out 2>&1; } 2> $1.time)
+  local step=()
+  [ -n "${DT_FRACTION:-}" ] && step=(-var dt_fraction "$DT_FRACTION")
+  (cd "$1" && { time nice $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" "${step[@]}" -log $1.log > $1.out 2>&1; } 2> $1.time)
 }
 declare -A pid
 for peer in $PEERS; do
@@ -125,6 +129,9 @@ tol_c=$(awk -v s="$g_csa_sd" -v f=$SD_FLOOR_CSA 'BEGIN {printf "%.3f", 3 * (s > 
   printf '%-10s %6.2f sd %5.2f (seeds) %6.2f sd %5.2f (seeds) %s\n' granucal "$g_angle" "$g_angle_sd" "$g_csa" "$g_csa_sd" \
     "3 seeds (seed,angle,CSA,granules): $(tr '\n' ' ' < granucal.csv)"
   fails=0
+  echo "code,angle_deg,angle_sd,csa_pct,csa_sd,frames,dt_fraction" > peers.csv
+  echo "granucal,$g_angle,$g_angle_sd,$g_csa,$g_csa_sd,3 seeds,own" >> peers.csv
+  echo "tolerance,$tol_a,,$tol_c,,," >> peers.csv
   for peer in $PEERS; do
     (. ./$peer.measure
      da=$(awk -v p="$angle" -v g="$g_angle" 'BEGIN {printf "%.2f", p - g}')
@@ -135,9 +142,11 @@ tol_c=$(awk -v s="$g_csa_sd" -v f=$SD_FLOOR_CSA 'BEGIN {printf "%.3f", 3 * (s > 
      printf '%-10s %6.2f sd %5.2f (time)  %6.2f sd %5.2f (time)  diff %+.2f deg %+.2f pts, %s (%d frames; %s granules, bed at rest CSA %.2f; %s wall)\n' \
        $peer "$angle" "$angle_sd" "$csa" "$csa_sd" "$da" "$dc" "$ok" "$frames" "$granules" "$bed_csa" \
        "$(grep real $peer/$peer.time | awk '{print $2}')"
+     echo "$peer,$angle,$angle_sd,$csa,$csa_sd,$frames,${DT_FRACTION:-deck}" >> peers.csv
      [ "$ok" = agrees ]) || fails=$((fails + 1))
   done
   echo "tolerance: angle +-$tol_a deg, CSA +-$tol_c points (3 x max(seed SD here, ci tier's at 40 rpm))"
+  echo "peers' step: dt_fraction ${DT_FRACTION:-as written in the deck, the a-priori step of granucal}"
   echo "test wall time $(( $(date +%s) - start )) s"
   echo "fails=$fails"
 } | tee summary.txt
