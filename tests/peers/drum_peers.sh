@@ -95,7 +95,7 @@ run_peer() { # CODE EXE DECK
   rm -rf "$1" && mkdir "$1" && cp "$export_dir"/*.in "$1/"
   local step=()
   [ -n "${DT_FRACTION:-}" ] && step=(-var dt_fraction "$DT_FRACTION")
-  (cd "$1" && { time nice $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" "${step[@]}" -log $1.log > $1.out 2>&1; } 2> $1.time)
+  (cd "$1" && { time $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" "${step[@]}" -log $1.log > $1.out 2>&1; } 2> $1.time)
 }
 declare -A pid
 for peer in $PEERS; do
