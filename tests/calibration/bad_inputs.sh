@@ -85,7 +85,7 @@ expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"
-cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': need NAME=MU_S,MU_R" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
+cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': expected NAME=MU_S,MU_R, both > 0" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
 cmd=synthesize expect "twin: a wall not in the config" "--wall granite: not a material" -- "$work/configs/good.yaml" "${walls[@]}" --wall granite=0.5,0.1 "${out[@]}"
 cmd=synthesize expect "twin: on the candidates' own bed" "--seeds: 2 is a bed of" -- "$work/configs/good.yaml" "${walls[@]}" --tier ci --seeds 2,101 "${out[@]}"
 # --plan checks every input as a run would (a bad one still fails), prints the plan, and
@@ -107,6 +107,28 @@ for c in calibrate simulate measure "study fidelity" synthesize; do
     else echo "FAIL $c $bad: exit $code, wanted one line naming '$bad' and \`granucal $c --help\`: $msg"; fails=$((fails + 1)); fi
   done
 done
+# A bad value of any command's option (calib/cal_options.c reads them all from each command's
+# table): one line naming the option, the value and what it accepts, exit 2; the help lists it.
+usage_error() { # usage_error WANT ARGS...: exit 2, one line on stderr holding WANT
+  local want=$1; shift
+  msg=$(timeout 20 "$bin" "$@" 2>&1 >/dev/null); code=$?
+  if [ $code -eq 2 ] && [ "$(wc -l <<< "$msg")" -eq 1 ] && grep -qF -- "$want" <<< "$msg"; then echo "ok   $*: $msg"
+  else echo "FAIL $*: exit $code, wanted one line with '$want': $msg"; fails=$((fails + 1)); fi
+}
+for c in calibrate "study fidelity" synthesize; do
+  usage_error "granucal $c: --jobs '0': expected a whole number in 1..1024" $c --jobs 0
+  help=$(timeout 20 "$bin" $c --help); code=$?
+  if [ $code -eq 0 ] && grep -q -- "--jobs N .*accepts a whole number in 1..1024" <<< "$(tr -s ' \n' ' ' <<< "$help")"; then
+    echo "ok   $c --help: lists --jobs with its range"
+  else echo "FAIL $c --help: exit $code, no '--jobs N ... accepts a whole number in 1..1024'"; fails=$((fails + 1)); fi
+done
+usage_error "granucal simulate: --checkpoint-every '-1': expected wall seconds in [0, 86400]" simulate "$src/configs/drum.yaml" --checkpoint-every -1
+usage_error "granucal study fidelity: --seeds '17': expected a whole number in 1..16" study fidelity --seeds 17
+usage_error "granucal measure: --radius 'wide': expected a radius in pixels > 0" measure photo.png --radius wide
+usage_error "granucal synthesize: --k-n '0': expected a stiffness in N/m > 0" synthesize --k-n 0
+usage_error "granucal calibrate: --stage 'polish': expected all, stiffness, granule or wall" calibrate --stage polish
+usage_error "granucal simulate: no SCENE.yaml given; see \`granucal simulate --help\`" simulate
+usage_error "granucal calibrate: unexpected argument 'b.yaml'; see \`granucal calibrate --help\`" calibrate a.yaml b.yaml
 # A wall lining the drum config does not have: the error lists those it has.
 drum_walls=$(sed -n 's/^  - {name: \([^,]*\),.*/\1/p' "$src/configs/drum.yaml" | paste -sd, | sed 's/,/, /g')
 cmd=simulate expect "unknown wall material" "wall = 'Steel': not 'granules' nor a name under materials; the walls are: granules, $drum_walls" -- "$src/configs/drum.yaml" --set wall=Steel --out "$work/out"
