@@ -65,7 +65,7 @@ typedef struct options {
 } options;
 
 typedef struct rung_result {
-    const cal_rung *rung;
+    const cal_tier *rung;
     int ran;                     ///< 1 measured, 0 skipped (predicted only)
     double predicted_s;          ///< wall time predicted before running (NAN: no basis yet)
     double depth;                ///< m, slice or full drum
@@ -178,26 +178,17 @@ static int narrow_speeds(cal_fidelity *f, const char *list, const char *path, ch
     return n ? 0 : exp_fail(err, len, "--rpm '%s': no speed given", list);
 }
 
-/// The rung as a calibration tier (the drum case takes one).
-static cal_tier tier_of(const cal_rung *r)
+// A rung is a tier with the drum's knobs alone (cal_config.h): its drum case
+// is the calibration's at the config's granule pair.
+static cal_drum_case case_of(const study *s, const cal_tier *r, int seed)
 {
-    return (cal_tier){.name = r->name, .lambda = r->lambda, .slice_depth = r->slice_depth, .max_time = r->max_time,
-                      .window = r->window, .sample_interval = r->sample_interval,
-                      .steady_angle_tol_deg = r->steady_angle_tol_deg,
-                      .steady_csa_tol_percent = r->steady_csa_tol_percent, .fill_method = r->fill_method,
-                      .average_time = r->average_time};
-}
-
-static cal_drum_case case_of(const study *s, const cal_rung *r, int seed)
-{
-    cal_tier t = tier_of(r);
-    cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+    cal_drum_case d = cal_drum_case_granule(s->c, r, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
     d.def.seed = d.fill.seed = (uint64_t)(s->c->seed + seed);
     return d;
 }
 
 // 1 if every simulation of the rung is already in the store.
-static int all_stored(const study *s, const cal_rung *r)
+static int all_stored(const study *s, const cal_tier *r)
 {
     const cal_fidelity *f = s->c->fidelity;
     for (int seed = 0; seed < f->seeds; ++seed) {
@@ -217,7 +208,7 @@ static int all_stored(const study *s, const cal_rung *r)
 // second ~ 1/dt ~ lambda^(-1/6) (eq. 14 with eq. 16-17: the coarse granule
 // keeps the mass, the stiffness falls as lambda^(-1/3)), simulated time ~
 // speeds x max_time plus the fill (about 3 s of settling whatever lambda).
-static double predict_wall(const rung_result *base, const cal_rung *r, double depth)
+static double predict_wall(const rung_result *base, const cal_tier *r, double depth)
 {
     const double fill_s = 3.0;
     double n = base->granules * (base->rung->lambda / r->lambda) * (depth / base->depth);
@@ -248,11 +239,10 @@ static double print_plan(const study *s)
     fprintf(stderr, "== plan: study fidelity, %d seed(s) x %u speed(s) a rung, %d worker(s); expected (worst case)\n", f->seeds,
             f->rpm_count, parallel);
     for (unsigned k = 0; k < f->rungs_count; ++k) {
-        const cal_rung *rung = &f->rungs[k];
+        const cal_tier *rung = &f->rungs[k];
         if (!wanted(s->opt.rungs, rung->name)) continue;
         cal_plan p = {{0}, {0}};
-        cal_tier t = tier_of(rung);
-        cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+        cal_drum_case d = cal_drum_case_granule(s->c, rung, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
         for (int w = 0; w < 2; ++w)
             cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w);
         int fits = spent + p.expected.wall_s <= budget_s;
@@ -696,7 +686,7 @@ static int run_ladder(study *s)
     const cal_fidelity *f = s->c->fidelity;
     double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
     for (unsigned k = 0; k < f->rungs_count && s->n < MAX_RUNGS; ++k) {
-        const cal_rung *rung = &f->rungs[k];
+        const cal_tier *rung = &f->rungs[k];
         if (!wanted(s->opt.rungs, rung->name)) continue;
         rung_result *r = &s->res[s->n++];
         memset(r, 0, sizeof *r);

@@ -59,6 +59,10 @@ expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its
 expect "unknown tier in the file" "good_tier.yaml:$(grep -n '^tier:' "$work/configs/good.yaml" | cut -d: -f1): tier: 'fast' is not one of its tiers: $tiers" -- "$(edit good_tier 's/^tier: quick/tier: fast/')" "${out[@]}"
 cmd=synthesize expect "synthesize: unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 cmd=study expect "study: unknown rung" "--rungs L1000-slice9-avg8,L3-full: 'L3-full' is not a rung of $work/configs/good.yaml (fidelity.rungs); its rungs: L65536-slice40, " -- fidelity "$work/configs/good.yaml" --rungs L1000-slice9-avg8,L3-full "${out[@]}"
+# A tier and a rung are one struct and one schema (cal_tier): a rung may not give a tier's own
+# keys, and a tier may not leave out those it needs (optional in the schema, for the rungs).
+cmd=study expect "rung with a tier's key" "grid: a key of a calibration tier: a rung takes the drum's" -- fidelity "$(edit rung_grid 's/{name: L4096-slice15, lambda/{name: L4096-slice15, grid: 3, lambda/')" --rungs L4096-slice15 --plan "${out[@]}"
+expect "tier without seeds" "seeds: a calibration tier needs it" -- "$(edit no_seeds '0,/^    seeds: 2/{/^    seeds: 2/d}')" --plan "${out[@]}"
 # A measured size table (gsd_table): its rows checked and named; not with the log-normal's keys; its basis required.
 printf 'size_um,cumulative_percent\n100,0\n200,40\n300,30\n400,100\n' > "$work/configs/psd.csv"
 expect "size table decreasing" "psd.csv:4: cumulative_percent: 30 is below the row above (40)" -- "$(edit psd 's/^median_diameter: .*/gsd_table: psd.csv\ngsd_basis: volume/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
