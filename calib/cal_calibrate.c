@@ -128,13 +128,9 @@ static int parse_options(int argc, char **argv, options *o)
                         "tests/calibration/plan_vs_committed.sh holds the expected figures within 30 % of what the "
                         "committed standard run (results/calibration-standard/) took."),
     };
-    const cal_command_line line = {.command = "calibrate", .synopsis = synopsis, .epilogue = epilogue,
-                                   .options = table, .n_options = sizeof table / sizeof *table,
-                                   .operand = "CONFIG.yaml", .min_operands = 0, .max_operands = 1};
-    char **operands;
-    int n_operands, status = cal_options_parse(&line, argc, argv, &operands, &n_operands);
-    if (!status && n_operands == 1) o->config = operands[0];
-    return status;
+    const cal_command_line line = {.command = "calibrate", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 // ---- stage results kept between runs of single stages ---------------------------------

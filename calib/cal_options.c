@@ -221,6 +221,16 @@ int cal_options_parse(const cal_command_line *line, int argc, char **argv, char 
     return check_operands(line, *operands, *n_operands);
 }
 
+int cal_options_parse_config(const cal_command_line *line, int argc, char **argv, const char **config)
+{
+    cal_command_line with_config = *line;
+    with_config.operand = "CONFIG.yaml", with_config.min_operands = 0, with_config.max_operands = 1;
+    char **operands;
+    int n_operands, status = cal_options_parse(&with_config, argc, argv, &operands, &n_operands);
+    if (!status && n_operands == 1) *config = operands[0];
+    return status;
+}
+
 // ---- --help --------------------------------------------------------------------------
 
 // "-o, --out DIR"

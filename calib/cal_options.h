@@ -64,6 +64,11 @@ typedef struct cal_command_line {
 /// and what it should be.
 int cal_options_parse(const cal_command_line *line, int argc, char **argv, char ***operands, int *n_operands);
 
+/// The same for the commands on a calibration config (calibrate, study,
+/// synthesize): `line`'s operand is at most one CONFIG.yaml, which replaces
+/// *config (its default) when given.
+int cal_options_parse_config(const cal_command_line *line, int argc, char **argv, const char **config);
+
 /// The command's help: synopsis, the options from the table, epilogue.
 void cal_options_print_help(const cal_command_line *line);
 

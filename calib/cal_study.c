@@ -118,13 +118,9 @@ static int parse_options(int argc, char **argv, options *o)
          .help = "run every rung: without --rungs the study prints its plan and stops with exit status 2 (the whole "
                  "ladder is many hours)"},
     };
-    const cal_command_line line = {.command = "study fidelity", .synopsis = synopsis, .epilogue = epilogue,
-                                   .options = table, .n_options = sizeof table / sizeof *table,
-                                   .operand = "CONFIG.yaml", .min_operands = 0, .max_operands = 1};
-    char **operands;
-    int n_operands, status = cal_options_parse(&line, argc, argv, &operands, &n_operands);
-    if (!status && n_operands == 1) o->config = operands[0];
-    return status;
+    const cal_command_line line = {.command = "study fidelity", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 static int wanted(const char *list, const char *name)

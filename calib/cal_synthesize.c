@@ -139,13 +139,9 @@ static int parse_options(int argc, char **argv, options *o)
                                        "--jobs workers, expected and worst case) and stop: nothing runs, no folder "
                                        "is made"),
     };
-    const cal_command_line line = {.command = "synthesize", .synopsis = synopsis, .epilogue = epilogue,
-                                   .options = table, .n_options = sizeof table / sizeof *table,
-                                   .operand = "CONFIG.yaml", .min_operands = 0, .max_operands = 1};
-    char **operands;
-    int n_operands, status = cal_options_parse(&line, argc, argv, &operands, &n_operands);
-    if (!status && n_operands == 1) o->config = operands[0];
-    return status;
+    const cal_command_line line = {.command = "synthesize", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 /// One drum lining to make: its surface name in the data files and its cases.
