@@ -2,7 +2,6 @@
 // `granucal calibrate`: the product. Validates every input, then runs the
 // stages, each from the result store where it can, and writes the table.
 #include <errno.h>
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +13,7 @@
 
 #include "cal_commands.h"
 #include "cal_mpi.h"
+#include "cal_options.h"
 #include "cal_plan.h"
 #include "cal_report.h"
 #include "cal_util.h"
@@ -24,7 +24,7 @@
 #include <omp.h>
 #endif
 
-static const char help[] =
+static const char synopsis[] =
     "usage: granucal calibrate [CONFIG.yaml] [options]\n"
     "\n"
     "Calibrate the linear spring-dashpot model with sliding and rolling friction of a\n"
@@ -49,37 +49,9 @@ static const char help[] =
     "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
     "(repose_angle.csv: surface,rpm,angle_deg,angle_sd_deg; occupied_area.csv:\n"
     "surface,rpm,csa_percent,csa_sd_percent), the powder, the candidates, the bounds and\n"
-    "the fidelity tiers. Every input is checked before the first simulation.\n"
-    "\n"
-    "options:\n"
-    "  --tier NAME        fidelity tier from the config (ci, quick, standard, paper, ...)\n"
-    "  --stage STAGE      all (default), stiffness, granule or wall; a later stage reads\n"
-    "                     the earlier stages' results from OUT, else the config's values\n"
-    "  --material NAME    fit this wall material only (implies --stage wall)\n"
-    "  --data DIR         read DIR/repose_angle.csv and DIR/occupied_area.csv instead of\n"
-    "                     the config's files (e.g. a twin made by granucal synthesize)\n"
-    "  --out DIR          results folder (default results/<config>-<tier>)\n"
-    "  --jobs N           simulations side by side on this machine (default: cores)\n"
-    "  --checkpoint-every S  wall seconds between a drum run's checkpoints (default 120;\n"
-    "                     0: none)\n"
-    "  --budget-hours H   refuse, before the first simulation, a run whose EXPECTED wall\n"
-    "                     time (the plan's, below) is over H hours; the worst case is\n"
-    "                     printed beside it, not judged\n"
-    "  --plan             check every input, print the plan and stop: nothing runs, no\n"
-    "                     folder is made. For each step and in all: simulations,\n"
-    "                     core-hours and wall hours on --jobs workers, EXPECTED and (in\n"
-    "                     parentheses) the worst case. Expected: each drum run ends at\n"
-    "                     the steady test's first chance (two windows, then its\n"
-    "                     averaging); COBYLA starts at the grid's best; the wall stages\n"
-    "                     share one grid; a two-tier stage runs its max_evaluations;\n"
-    "                     k_n is stage 1's choice where its cylinders are already in\n"
-    "                     OUT/store, else the config's. Worst case: max_time, every\n"
-    "                     evaluation, the stiffest k_n. Records already in OUT/store\n"
-    "                     are not subtracted. tests/calibration/plan_vs_committed.sh\n"
-    "                     holds the expected figures within 30 % of what the committed\n"
-    "                     standard run (results/calibration-standard/) took.\n"
-    "  -h, --help         this text\n"
-    "\n"
+    "the fidelity tiers. Every input is checked before the first simulation.\n";
+
+static const char epilogue[] =
     "Progress: one line per simulation on stderr, ending with the step of the whole\n"
     "calibration (stiffness, granule, each wall material), the simulations done of the\n"
     "most it may take, and the time left at most, from the measured cost of each kind of\n"
@@ -113,50 +85,52 @@ typedef struct options {
     int plan_only;       ///< --plan: stop after printing the plan
 } options;
 
+static const char *const stages[] = {"all", "stiffness", "granule", "wall", NULL};
+
+// --material NAME: that wall material alone, so the wall stage alone (a later --stage still wins).
+static int take_material(const char *text, void *context)
+{
+    options *o = context;
+    o->material = text, o->stage = "wall";
+    return 0;
+}
+
+// 0: parsed; -1: --help printed; else the exit status of a usage error.
 static int parse_options(int argc, char **argv, options *o)
 {
-    static const struct option longs[] = {{"tier", 1, 0, 't'},     {"stage", 1, 0, 's'}, {"material", 1, 0, 'm'},
-                                          {"out", 1, 0, 'o'},      {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},
-                                          {"checkpoint-every", 1, 0, 'c'}, {"data", 1, 0, 'd'},
-                                          {"budget-hours", 1, 0, 'b'}, {"plan", 0, 0, 'p'},
-                                          {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S,
-                   .budget_hours = NAN};
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    o->jobs = ncpu > 0 ? (int)ncpu : 1;
-    int c;
-    optind = 1, opterr = 0;
-    while ((c = getopt_long(argc, argv, ":h", longs, NULL)) != -1) {
-        double v;
-        switch (c) {
-        case 't': o->tier = optarg; break;
-        case 's': o->stage = optarg; break;
-        case 'm': o->material = optarg, o->stage = "wall"; break;
-        case 'o': o->out = optarg; break;
-        case 'd': o->data = optarg; break;
-        case 'p': o->plan_only = 1; break;
-        case 'b':
-            if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
-                return fprintf(stderr, "granucal calibrate: --budget-hours '%s': expected a number of hours > 0\n", optarg), 2;
-            break;
-        case 'j':
-            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024))
-                return fprintf(stderr, "granucal calibrate: --jobs '%s': expected a whole number in 1..1024\n", optarg), 2;
-            o->jobs = (int)v;
-            break;
-        case 'c':
-            if (cal_parse_checkpoint_every("calibrate", optarg, &o->checkpoint_every_s)) return 2;
-            break;
-        case 'h': fputs(help, stdout); return -1;
-        default: return cal_option_error("calibrate", c, argv);
-        }
-    }
-    if (optind < argc) o->config = argv[optind++];
-    if (optind < argc) return fprintf(stderr, "granucal calibrate: unexpected argument '%s'\n", argv[optind]), 2;
-    const char *stages[] = {"all", "stiffness", "granule", "wall"};
-    for (int k = 0; k < 4; ++k)
-        if (strcmp(o->stage, stages[k]) == 0) return 0;
-    return fprintf(stderr, "granucal calibrate: --stage '%s': use all, stiffness, granule or wall\n", o->stage), 2;
+                   .budget_hours = NAN, .jobs = cal_default_jobs()};
+    const cal_option table[] = {
+        cal_option_tier(&o->tier, "fidelity tier from the config (ci, quick, standard, paper, ...)"),
+        {.name = "stage", .kind = CAL_OPT_CHOICE, .text = &o->stage, .choices = stages, .value = "STAGE",
+         .help = "the stage to run (default all); a later stage reads the earlier stages' results from OUT, else "
+                 "the config's values"},
+        {.name = "material", .kind = CAL_OPT_CUSTOM, .parse = take_material, .context = o, .value = "NAME",
+         .help = "fit this wall material only (implies --stage wall)"},
+        {.name = "data", .kind = CAL_OPT_TEXT, .text = &o->data, .value = "DIR",
+         .help = "read DIR/repose_angle.csv and DIR/occupied_area.csv instead of the config's files (e.g. a twin "
+                 "made by granucal synthesize)"},
+        cal_option_out(&o->out, "results folder (default results/<config>-<tier>)"),
+        cal_option_jobs(&o->jobs),
+        cal_option_checkpoint_every(&o->checkpoint_every_s, "wall seconds between a drum run's checkpoints "
+                                                            "(default 120; 0: none)"),
+        cal_option_budget_hours(&o->budget_hours,
+                                "refuse, before the first simulation, a run whose EXPECTED wall time (the plan's, "
+                                "below) is over H hours; the worst case is printed beside it, not judged"),
+        cal_option_plan(&o->plan_only,
+                        "check every input, print the plan and stop: nothing runs, no folder is made. For each step "
+                        "and in all: simulations, core-hours and wall hours on --jobs workers, EXPECTED and (in "
+                        "parentheses) the worst case. Expected: each drum run ends at the steady test's first chance "
+                        "(two windows, then its averaging); COBYLA starts at the grid's best; the wall stages share "
+                        "one grid; a two-tier stage runs its max_evaluations; k_n is stage 1's choice where its "
+                        "cylinders are already in OUT/store, else the config's. Worst case: max_time, every "
+                        "evaluation, the stiffest k_n. Records already in OUT/store are not subtracted. "
+                        "tests/calibration/plan_vs_committed.sh holds the expected figures within 30 % of what the "
+                        "committed standard run (results/calibration-standard/) took."),
+    };
+    const cal_command_line line = {.command = "calibrate", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 // ---- stage results kept between runs of single stages ---------------------------------

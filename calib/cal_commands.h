@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file cal_commands.h
-/// The sub-commands of granucal; each parses its own options.
+/// The sub-commands of granucal; each reads its options from its own table
+/// (cal_options.h).
 #ifndef CAL_COMMANDS_H
 #define CAL_COMMANDS_H
 

@@ -30,6 +30,9 @@ static const cyaml_strval_t corrections[] = {{"kriging", CAL_MF_KRIGING}, {"affi
 static const cyaml_strval_t purposes[] = {{"calibration", 0}, {"demonstration", 1}};
 static const cyaml_strval_t stiffness_scenes[] = {{"cylinder", 0}, {"drum", 1}};
 
+// A calibration tier and a fidelity rung: one schema. The drum's knobs come
+// first; a tier's own keys are optional here, so that a rung reads without
+// them, and are required or refused by check_tier and check_fidelity.
 #define TIER_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_tier, member)
 static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_tier, name, 1, 31),
@@ -45,14 +48,14 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_SEQUENCE("average_time_per_rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, average_time_per_rpm,
                          &float_entry, 1, 32),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
-    TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_DEFAULT),
+    TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_SEQUENCE("stiffness", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, stiffness, &float_entry, 2, 64),
     CYAML_FIELD_ENUM_PTR("stiffness_scene", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, stiffness_scene,
                          stiffness_scenes, CYAML_ARRAY_LEN(stiffness_scenes)),
-    CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_tier, seeds),
-    CYAML_FIELD_INT("grid", CYAML_FLAG_DEFAULT, cal_tier, grid),
-    CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_DEFAULT, cal_tier, max_evaluations),
-    TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_DEFAULT),
+    CYAML_FIELD_INT("seeds", CYAML_FLAG_OPTIONAL, cal_tier, seeds),
+    CYAML_FIELD_INT("grid", CYAML_FLAG_OPTIONAL, cal_tier, grid),
+    CYAML_FIELD_INT("max_evaluations", CYAML_FLAG_OPTIONAL, cal_tier, max_evaluations),
+    TIER_FLOAT("angle_sd_deg", angle_sd_deg, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("angle_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, angle_rule, 1, 16),
     CYAML_FIELD_SEQUENCE("csa_sd_percent", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, csa_sd_percent,
                          &float_entry, 1, 32),
@@ -68,26 +71,11 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_END};
 static const cyaml_schema_value_t tier_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_tier, tier_fields)};
 
-#define RUNG_FLOAT(key, member, flag) CYAML_FIELD_FLOAT(key, flag, cal_rung, member)
-static const cyaml_schema_field_t rung_fields[] = {
-    CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, cal_rung, name, 1, 31),
-    RUNG_FLOAT("lambda", lambda, CYAML_FLAG_DEFAULT),
-    RUNG_FLOAT("slice_depth", slice_depth, CYAML_FLAG_DEFAULT),
-    RUNG_FLOAT("max_time", max_time, CYAML_FLAG_DEFAULT),
-    RUNG_FLOAT("window", window, CYAML_FLAG_DEFAULT),
-    RUNG_FLOAT("sample_interval", sample_interval, CYAML_FLAG_OPTIONAL),
-    RUNG_FLOAT("steady_angle_tol_deg", steady_angle_tol_deg, CYAML_FLAG_OPTIONAL),
-    RUNG_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
-    CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_rung, fill_method, 1, 16),
-    RUNG_FLOAT("average_time", average_time, CYAML_FLAG_OPTIONAL),
-    CYAML_FIELD_END};
-static const cyaml_schema_value_t rung_entry = {CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cal_rung, rung_fields)};
-
 static const cyaml_schema_field_t fidelity_fields[] = {
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_POINTER, cal_fidelity, rpm, &float_entry, 1, 16),
     CYAML_FIELD_INT("seeds", CYAML_FLAG_DEFAULT, cal_fidelity, seeds),
     CYAML_FIELD_FLOAT("budget_hours", CYAML_FLAG_DEFAULT, cal_fidelity, budget_hours),
-    CYAML_FIELD_SEQUENCE("rungs", CYAML_FLAG_POINTER, cal_fidelity, rungs, &rung_entry, 1, 32), CYAML_FIELD_END};
+    CYAML_FIELD_SEQUENCE("rungs", CYAML_FLAG_POINTER, cal_fidelity, rungs, &tier_entry, 1, 32), CYAML_FIELD_END};
 
 static const cyaml_schema_field_t bounds_fields[] = {
     CYAML_FIELD_FLOAT("mu_s_min", CYAML_FLAG_DEFAULT, cal_bounds, mu_s_min),
@@ -178,29 +166,30 @@ static int block_of(const cal_config *c, const char *name)
     return 1;
 }
 
-// The knobs a tier and a rung share; `optional` holds sample_interval,
-// steady_angle_tol_deg and steady_csa_tol_percent (0 or absent: the drum's default).
-static int check_drum_knobs(const cal_config *c, int from, double lambda, double slice_depth, double max_time,
-                            double window, const double optional[3], const char *fill_method, double average_time,
-                            char *err, size_t len)
+// The drum's knobs, a tier's or a rung's; sample_interval and the steady
+// test's tolerances are optional (0 or absent: the drum's default).
+static int check_drum_knobs(const cal_config *c, int from, const cal_tier *t, char *err, size_t len)
 {
-    if (!(isfinite(average_time) && average_time >= 0 && 2 * window + average_time <= max_time))
+    if (!(isfinite(t->average_time) && t->average_time >= 0 && 2 * t->window + t->average_time <= t->max_time))
         return located(c, from, "average_time", err, len, "%g must be >= 0 and fit with two windows (%g s) in max_time (%g s)",
-                       average_time, 2 * window, max_time);
+                       t->average_time, 2 * t->window, t->max_time);
     exp_drum_fill_method method;
-    if (fill_method && exp_drum_fill_method_from_name(fill_method, &method))
-        return located(c, from, "fill_method", err, len, "'%s': use pour or pack", fill_method);
-    if (!(isfinite(lambda) && lambda >= 1)) return located(c, from, "lambda", err, len, "%g must be >= 1", lambda);
-    if (bad_positive(max_time)) return located(c, from, "max_time", err, len, "%g must be > 0", max_time);
-    if (bad_positive(window)) return located(c, from, "window", err, len, "%g must be > 0", window);
-    if (!(isfinite(slice_depth) && slice_depth >= 0))
-        return located(c, from, "slice_depth", err, len, "%g must be >= 0 and finite (0: full drum)", slice_depth);
-    if (!(2 * window <= max_time))
-        return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * window, max_time);
-    static const char *const optional_names[3] = {"sample_interval", "steady_angle_tol_deg", "steady_csa_tol_percent"};
-    for (int k = 0; k < 3; ++k)
-        if (!(isfinite(optional[k]) && optional[k] >= 0))
-            return located(c, from, optional_names[k], err, len, "%g must be >= 0 and finite (0: the default)", optional[k]);
+    if (t->fill_method && exp_drum_fill_method_from_name(t->fill_method, &method))
+        return located(c, from, "fill_method", err, len, "'%s': use pour or pack", t->fill_method);
+    if (!(isfinite(t->lambda) && t->lambda >= 1)) return located(c, from, "lambda", err, len, "%g must be >= 1", t->lambda);
+    if (bad_positive(t->max_time)) return located(c, from, "max_time", err, len, "%g must be > 0", t->max_time);
+    if (bad_positive(t->window)) return located(c, from, "window", err, len, "%g must be > 0", t->window);
+    if (!(isfinite(t->slice_depth) && t->slice_depth >= 0))
+        return located(c, from, "slice_depth", err, len, "%g must be >= 0 and finite (0: full drum)", t->slice_depth);
+    if (!(2 * t->window <= t->max_time))
+        return located(c, from, "window", err, len, "two windows (%g s) must fit in max_time (%g s)", 2 * t->window,
+                       t->max_time);
+    const struct { const char *field; double v; } optional[] = {
+        {"sample_interval", t->sample_interval}, {"steady_angle_tol_deg", t->steady_angle_tol_deg},
+        {"steady_csa_tol_percent", t->steady_csa_tol_percent}};
+    for (size_t k = 0; k < sizeof optional / sizeof *optional; ++k)
+        if (!(isfinite(optional[k].v) && optional[k].v >= 0))
+            return located(c, from, optional[k].field, err, len, "%g must be >= 0 and finite (0: the default)", optional[k].v);
     return 0;
 }
 
@@ -254,10 +243,11 @@ static int check_stiffness(const cal_config *c, int from, const double *k, unsig
 static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t len)
 {
     int from = block_of(c, t->name); // the tier's own block starts at its `name:` line
-    const double optional[3] = {t->sample_interval, t->steady_angle_tol_deg, t->steady_csa_tol_percent};
-    if (check_drum_knobs(c, from, t->lambda, t->slice_depth, t->max_time, t->window, optional, t->fill_method,
-                         t->average_time, err, len))
-        return 1;
+    if (check_drum_knobs(c, from, t, err, len)) return 1;
+    // Optional in the schema that a rung shares, required of a tier (absent reads as 0):
+    static const char NEEDED[] = "a calibration tier needs it (the fidelity study's rungs do not)";
+    if (t->cylinder_lambda == 0) return exp_fail(err, len, "%s:%d: cylinder_lambda: %s", c->path, from, NEEDED);
+    if (t->seeds == 0) return exp_fail(err, len, "%s:%d: seeds: %s", c->path, from, NEEDED);
     if (!(isfinite(t->cylinder_lambda) && t->cylinder_lambda >= 1))
         return located(c, from, "cylinder_lambda", err, len, "%g must be >= 1", t->cylinder_lambda);
     if (check_stiffness(c, from, t->stiffness, t->stiffness_count, err, len)) return 1;
@@ -287,6 +277,21 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
     if (t->map_correction && !t->map_tier)
         return located(c, from, "map_correction", err, len, "only a tier with a map_tier corrects a map");
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
+}
+
+const char *cal_tier_calibration_key(const cal_tier *t)
+{
+    const struct { const char *key; int given; } keys[] = {
+        {"average_time_per_rpm", t->average_time_per_rpm_count > 0}, {"rpm", t->rpm_count > 0},
+        {"cylinder_lambda", t->cylinder_lambda != 0}, {"stiffness", t->stiffness_count > 0},
+        {"stiffness_scene", t->stiffness_scene != NULL}, {"seeds", t->seeds != 0}, {"grid", t->grid != 0},
+        {"max_evaluations", t->max_evaluations != 0}, {"angle_sd_deg", t->angle_sd_deg != 0},
+        {"angle_rule", t->angle_rule != NULL}, {"csa_sd_percent", t->csa_sd_percent_count > 0},
+        {"bound_probes", t->bound_probes != NULL}, {"map_tier", t->map_tier != NULL},
+        {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL}};
+    for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k)
+        if (keys[k].given) return keys[k].key;
+    return NULL;
 }
 
 int cal_tier_angle_in_misfit(const cal_tier *t) { return t->angle_rule && strcmp(t->angle_rule, "misfit") == 0; }
@@ -327,14 +332,16 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
         if (!(f->rpm[k] > 0 && f->rpm[k] <= 1000))
             return located(c, from, "fidelity.rpm", err, len, "%g must be in (0, 1000]", f->rpm[k]);
     for (unsigned k = 0; k < f->rungs_count; ++k) {
-        const cal_rung *r = &f->rungs[k];
+        const cal_tier *r = &f->rungs[k];
         for (unsigned j = 0; j < k; ++j)
             if (strcmp(r->name, f->rungs[j].name) == 0)
                 return located(c, from, "fidelity.rungs", err, len, "rung '%s' is defined twice", r->name);
-        const double optional[3] = {r->sample_interval, r->steady_angle_tol_deg, r->steady_csa_tol_percent};
-        if (check_drum_knobs(c, block_of(c, r->name), r->lambda, r->slice_depth, r->max_time, r->window, optional,
-                             r->fill_method, r->average_time, err, len))
-            return 1;
+        const char *tier_key = cal_tier_calibration_key(r);
+        if (tier_key)
+            return located(c, block_of(c, r->name), tier_key, err, len, "a key of a calibration tier: a rung takes the "
+                           "drum's (lambda, slice_depth, max_time, window, sample_interval, steady_angle_tol_deg, "
+                           "steady_csa_tol_percent, fill_method, average_time); the study's speeds are fidelity.rpm");
+        if (check_drum_knobs(c, block_of(c, r->name), r, err, len)) return 1;
     }
     return 0;
 }

@@ -24,17 +24,24 @@ typedef struct cal_bounds {
 } cal_bounds;
 
 /// A fidelity tier: every accuracy knob of the virtual experiments, and
-/// the search budget that goes with it.
+/// the search budget that goes with it. A rung of the fidelity study is the
+/// same struct, read by the same schema, with the drum's knobs alone (name
+/// to average_time below, cal_tier_calibration_key says which others a rung
+/// may not give): the study runs a rung's drum as the calibration runs a
+/// tier's, through the same drum case and so the same store keys.
 typedef struct cal_tier {
+    // The drum's knobs, a tier's and a rung's:
     char *name;
     double lambda;          ///< drum coarse-graining factor (eq. 15)
     double slice_depth;     ///< periodic slice depth, m; 0 = the full drum with end plates
     double max_time;        ///< s of turning at most per speed
     double window;          ///< s, steady-state averaging window
-    double sample_interval; ///< s between drum-face measurements
-    double steady_angle_tol_deg, steady_csa_tol_percent;
+    double sample_interval; ///< s between drum-face measurements (optional; 0: the drum's default)
+    double steady_angle_tol_deg, steady_csa_tol_percent; ///< optional; 0: the drum's defaults
     char *fill_method;      ///< how the drum's bed is built: "pour" (absent) or "pack" (exp_drum_fill_method)
     double average_time;    ///< s averaged on after the steady test holds (exp_drum_run_opts; 0: none)
+    // A calibration tier's alone (optional in the schema, so that a rung
+    // reads without them; check_tier requires cylinder_lambda and seeds):
     /// The same, one per entry of rpm (replaces average_time): a slow drum
     /// avalanches and needs seconds of averaging for its angle, a fast one
     /// flows steadily and needs far less for its CSA.
@@ -53,9 +60,9 @@ typedef struct cal_tier {
     /// λ, slice, fill and fill method, poured with pour_mu_s, pour_mu_r).
     int *stiffness_scene;
     int seeds;              ///< poured beds per stiffness (seed-to-seed spread)
-    int grid;               ///< initial design: grid points per axis of (μs, log μr)
-    int max_evaluations;    ///< NLopt evaluations after the grid
-    double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint
+    int grid;               ///< initial design: grid points per axis of (μs, log μr); absent: 0, none
+    int max_evaluations;    ///< NLopt evaluations after the grid; absent: 0
+    double angle_sd_deg;    ///< the tier's own angle spread (measured), added to the lab's in the constraint; absent: 0
     /// How the angle enters the friction search: "constraint" (absent: the
     /// paper's rule, sections 4.2-4.3: the angle within its tolerance first,
     /// then the best CSA misfit) or "misfit" (the angle is one more
@@ -110,14 +117,9 @@ double cal_tier_csa_sd(const cal_tier *t, unsigned i);
 /// entry for that speed, else average_time.
 double cal_tier_average_time(const cal_tier *t, double rpm);
 
-/// A rung of the fidelity study: the drum's accuracy knobs only.
-typedef struct cal_rung {
-    char *name;
-    double lambda, slice_depth, max_time, window; ///< as in a tier
-    double sample_interval, steady_angle_tol_deg, steady_csa_tol_percent; ///< optional, as in a tier
-    char *fill_method;                                                    ///< optional, as in a tier
-    double average_time;                                                  ///< optional, as in a tier
-} cal_rung;
+/// The first key of a calibration tier alone that t gives (a value other
+/// than 0 or absent), NULL if none: a rung of the fidelity study may not.
+const char *cal_tier_calibration_key(const cal_tier *t);
 
 /// The fidelity study (`granucal study fidelity`): the drum lined with
 /// granules (wall pair = granule pair: Table 3's aluminium drum, as in Table
@@ -128,7 +130,7 @@ typedef struct cal_fidelity {
     unsigned rpm_count;
     int seeds;                   ///< seeds per rung (the spread)
     double budget_hours;         ///< a rung predicted to take longer is listed, not run
-    cal_rung *rungs;
+    cal_tier *rungs;             ///< each the drum's knobs of a tier alone
     unsigned rungs_count;
 } cal_fidelity;
 

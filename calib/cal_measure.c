@@ -3,7 +3,6 @@
 // real drum photographs (or the frames of a video), and their mean and
 // spread as the rows of experiments/data/'s CSV files.
 #include <errno.h>
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,10 +12,11 @@
 
 #include "cal_commands.h"
 #include "cal_data.h"
+#include "cal_options.h"
 #include "cal_util.h"
 #include "exp_photo.h"
 
-static const char measure_help[] =
+static const char measure_synopsis[] =
     "usage: granucal measure PHOTO.png... [--center X,Y --radius R] [--dark | --light] [--closing N]\n"
     "                        [--max-sd F] [--mask OUT] [--surface NAME --rpm RPM [--csv-angle FILE]\n"
     "                        [--csv-area FILE] [--skip-refused]]\n"
@@ -24,13 +24,13 @@ static const char measure_help[] =
     "Measure photographs of the drum face as the paper does by hand (sections 3.2.2-3.2.3):\n"
     "  csa_percent  powder pixels over pixels inside the drum circle (eq. 20)\n"
     "  angle_deg    angle to the horizontal of a line fitted to the free surface\n"
-    "               over the central 60 %% of its width (angle_signed_deg: counter-\n"
+    "               over the central 60 % of its width (angle_signed_deg: counter-\n"
     "               clockwise positive, as granucal's simulations report it)\n"
     "\n"
     "The drum: without --center/--radius it is found (the strongest circle in the\n"
     "picture, then the innermost edge concentric with it: the inside of the rim).\n"
     "With them (pixels, image y downwards) it is moved onto the drum's inner edge\n"
-    "within 3 %% of R of the centre and 4 %% of the radius given. Either way the\n"
+    "within 3 % of R of the centre and 4 % of the radius given. Either way the\n"
     "circle used is printed (center, radius) and drawn in red in --mask.\n"
     "The powder: two tones are told apart under uneven light (a threshold halfway\n"
     "between planes fitted to each tone's grey levels); the powder is the tone that\n"
@@ -46,10 +46,11 @@ static const char measure_help[] =
     "and standard deviation; a number it does not have is null (the spread of one\n"
     "photo). --mask OUT writes the photo with the powder tinted, the circle, the\n"
     "surface points used and the line (several photos: OUT is a directory, one mask\n"
-    "per photo under the photo's file name).\n"
-    "\n"
+    "per photo under the photo's file name).\n";
+
+static const char measure_epilogue[] =
     "From a video of the drum to the calibration's input files:\n"
-    "  ffmpeg -i run.mp4 -vf fps=2 frames/%%04d.png     # (crop first if the drum is small)\n"
+    "  ffmpeg -i run.mp4 -vf fps=2 frames/%04d.png     # (crop first if the drum is small)\n"
     "  granucal measure frames/*.png --surface PTFE --rpm 4 \\\n"
     "      --csv-angle experiments/data/repose_angle.csv --csv-area experiments/data/occupied_area.csv\n"
     "appends 'PTFE,4,<mean angle>,<sd>' to repose_angle.csv (surface,rpm,angle_deg,angle_sd_deg)\n"
@@ -66,23 +67,22 @@ typedef struct measure_args {
     const char *mask, *surface, *csv_angle, *csv_area;
     double rpm;
     int skip_refused;
+    int tone;                  ///< --dark, --light: exp_powder_tone
+    double cx, cy, radius;     ///< --center, --radius (NAN: not given)
+    char **photos;
+    int n_photos;
 } measure_args;
 
-static int parse_pair(const char *s, double *a, double *b)
+// --center X,Y: two numbers.
+static int take_center(const char *s, void *context)
 {
+    measure_args *a = context;
     char *end;
-    *a = strtod(s, &end);
+    a->cx = strtod(s, &end);
     if (end == s || *end != ',') return 1;
     const char *p = end + 1;
-    *b = strtod(p, &end);
-    return end == p || *end != '\0';
-}
-
-static int parse_number(const char *s, double *out)
-{
-    char *end;
-    *out = strtod(s, &end);
-    return end == s || *end != '\0' || !isfinite(*out);
+    a->cy = strtod(p, &end);
+    return end == p || *end != '\0' || !isfinite(a->cx) || !isfinite(a->cy);
 }
 
 static int usage(const char *why)
@@ -91,49 +91,58 @@ static int usage(const char *why)
     return 2;
 }
 
-enum { OPT_SURFACE = 256, OPT_RPM, OPT_CSV_ANGLE, OPT_CSV_AREA, OPT_SKIP, OPT_MAX_SD };
+// The options that go together, once all are read.
+static int check_together(measure_args *a)
+{
+    if (isnan(a->cx) != isnan(a->radius)) return usage("--center and --radius go together (or neither: the drum is found)");
+    a->circle_given = !isnan(a->cx);
+    a->circle = (exp_circle){a->cx, a->cy, a->radius, 0};
+    a->opts.tone = (exp_powder_tone)a->tone;
+    if ((a->csv_angle || a->csv_area) && (!a->surface || !(a->rpm > 0)))
+        return usage("--csv-angle and --csv-area need --surface NAME and --rpm RPM");
+    return 0;
+}
 
 // 0: parsed; -1: --help printed; else the exit status of a usage error.
 static int parse_args(int argc, char **argv, measure_args *a)
 {
-    static const struct option opts[] = {
-        {"center", required_argument, 0, 'c'},  {"radius", required_argument, 0, 'r'},
-        {"invert", no_argument, 0, 'i'},        {"light", no_argument, 0, 'i'},
-        {"dark", no_argument, 0, 'd'},          {"closing", required_argument, 0, 'k'},
-        {"mask", required_argument, 0, 'm'},    {"help", no_argument, 0, 'h'},
-        {"surface", required_argument, 0, OPT_SURFACE}, {"rpm", required_argument, 0, OPT_RPM},
-        {"csv-angle", required_argument, 0, OPT_CSV_ANGLE}, {"csv-area", required_argument, 0, OPT_CSV_AREA},
-        {"skip-refused", no_argument, 0, OPT_SKIP}, {"max-sd", required_argument, 0, OPT_MAX_SD},
-        {0}};
-    double cx = NAN, cy = NAN, radius = NAN;
-    int c;
-    optind = 1, opterr = 0;
-    while ((c = getopt_long(argc, argv, ":c:r:idk:m:h", opts, NULL)) != -1) {
-        char *end = NULL;
-        if (c == 'h') return printf(measure_help), -1;
-        if (c == 'c' && parse_pair(optarg, &cx, &cy)) return usage("--center X,Y: two numbers");
-        if (c == 'r' && (parse_number(optarg, &radius) || !(radius > 0))) return usage("--radius R: a positive number");
-        if (c == 'i') a->opts.tone = EXP_POWDER_LIGHT;
-        if (c == 'd') a->opts.tone = EXP_POWDER_DARK;
-        if (c == 'k' && ((a->opts.closing_px = (int)strtol(optarg, &end, 10)) < 0 || *end))
-            return usage("--closing N: pixels, 0 or more");
-        if (c == 'm') a->mask = optarg;
-        if (c == OPT_SURFACE) a->surface = optarg;
-        if (c == OPT_RPM && (parse_number(optarg, &a->rpm) || !(a->rpm > 0))) return usage("--rpm: a positive number");
-        if (c == OPT_CSV_ANGLE) a->csv_angle = optarg;
-        if (c == OPT_CSV_AREA) a->csv_area = optarg;
-        if (c == OPT_SKIP) a->skip_refused = 1;
-        if (c == OPT_MAX_SD && (parse_number(optarg, &a->opts.max_sd_fraction) || !(a->opts.max_sd_fraction > 0)))
-            return usage("--max-sd F: a positive fraction of the drum radius");
-        if (c == '?' || c == ':') return cal_option_error("measure", c, argv);
-    }
-    if (optind >= argc) return usage("no photo given");
-    if (isnan(cx) != isnan(radius)) return usage("--center and --radius go together (or neither: the drum is found)");
-    a->circle_given = !isnan(cx);
-    a->circle = (exp_circle){cx, cy, radius, 0};
-    if ((a->csv_angle || a->csv_area) && (!a->surface || !(a->rpm > 0)))
-        return usage("--csv-angle and --csv-area need --surface NAME and --rpm RPM");
-    return 0;
+    a->cx = a->cy = a->radius = NAN, a->tone = (int)a->opts.tone;
+    const cal_option table[] = {
+        {.name = "center", .short_name = 'c', .kind = CAL_OPT_CUSTOM, .parse = take_center, .context = a,
+         .value = "X,Y", .expected = "X,Y: two numbers (pixels)",
+         .help = "the drum's centre, pixels, image y downwards (with --radius; default: found)"},
+        {.name = "radius", .short_name = 'r', .kind = CAL_OPT_REAL, .real = &a->radius, .lo = 0, .lo_open = 1,
+         .hi = INFINITY, .value = "R", .expected = "a radius in pixels", .help = "the drum's inner radius, pixels"},
+        {.name = "dark", .short_name = 'd', .kind = CAL_OPT_FLAG, .flag = &a->tone, .set_to = EXP_POWDER_DARK,
+         .help = "the powder is the darker tone"},
+        {.name = "light", .kind = CAL_OPT_FLAG, .flag = &a->tone, .set_to = EXP_POWDER_LIGHT,
+         .help = "the powder is the lighter tone"},
+        {.name = "invert", .short_name = 'i', .kind = CAL_OPT_FLAG, .flag = &a->tone, .set_to = EXP_POWDER_LIGHT,
+         .help = "the same as --light"},
+        {.name = "closing", .short_name = 'k', .kind = CAL_OPT_INT, .integer = &a->opts.closing_px, .lo = 0,
+         .hi = 10000, .value = "N", .expected = "a whole number of pixels",
+         .help = "close the powder's pores with a disc of N pixels (default 3)"},
+        {.name = "max-sd", .kind = CAL_OPT_REAL, .real = &a->opts.max_sd_fraction, .lo = 0, .lo_open = 1,
+         .hi = INFINITY, .value = "F", .expected = "a fraction of the drum radius",
+         .help = "refuse a photo whose surface lies more than F times R about its line (default 0.04)"},
+        {.name = "mask", .short_name = 'm', .kind = CAL_OPT_TEXT, .text = &a->mask, .value = "OUT",
+         .help = "write the photo with what was measured drawn on it (several photos: OUT is a directory)"},
+        {.name = "surface", .kind = CAL_OPT_TEXT, .text = &a->surface, .value = "NAME",
+         .help = "the drum lining, the rows' surface column"},
+        {.name = "rpm", .kind = CAL_OPT_REAL, .real = &a->rpm, .lo = 0, .lo_open = 1, .hi = INFINITY,
+         .value = "RPM", .expected = "a drum speed (rpm)", .help = "the drum's speed, the rows' rpm column"},
+        {.name = "csv-angle", .kind = CAL_OPT_TEXT, .text = &a->csv_angle, .value = "FILE",
+         .help = "append the mean angle and its spread to FILE (repose_angle.csv's columns)"},
+        {.name = "csv-area", .kind = CAL_OPT_TEXT, .text = &a->csv_area, .value = "FILE",
+         .help = "append the mean CSA and its spread to FILE (occupied_area.csv's columns)"},
+        {.name = "skip-refused", .kind = CAL_OPT_FLAG, .flag = &a->skip_refused, .set_to = 1,
+         .help = "write the rows from the photos measured, leaving the refused ones out"},
+    };
+    const cal_command_line line = {.command = "measure", .synopsis = measure_synopsis, .epilogue = measure_epilogue,
+                                   .options = table, .n_options = sizeof table / sizeof *table,
+                                   .operand = "photo", .min_operands = 1, .max_operands = -1};
+    int status = cal_options_parse(&line, argc, argv, &a->photos, &a->n_photos);
+    return status ? status : check_together(a);
 }
 
 // A JSON string, quotes and backslashes escaped, control characters dropped.
@@ -287,13 +296,13 @@ int cal_cmd_measure(int argc, char **argv)
     measure_args a = {.opts = exp_default_photo_opts()};
     int rc = parse_args(argc, argv, &a);
     if (rc) return rc < 0 ? 0 : rc;
-    int several = argc - optind > 1;
+    int several = a.n_photos > 1;
     struct stat st;
     if (a.mask && several && (stat(a.mask, &st) != 0 || !S_ISDIR(st.st_mode)))
         return usage("--mask with several photos names an existing directory (one mask per photo)");
     frame_stats s = {0};
     int bad = 0;
-    for (int k = optind; k < argc; ++k) bad |= measure_one(&a, argv[k], several, &s);
+    for (int k = 0; k < a.n_photos; ++k) bad |= measure_one(&a, a.photos[k], several, &s);
     if (several) print_summary(&s);
     if (s.failed && s.frames > 1)
         fprintf(stderr, "granucal measure: %d of %d photos not measured\n", s.failed, s.frames);

@@ -266,16 +266,6 @@ static int killed_from_outside(int sig)
     return sig == SIGKILL || sig == SIGTERM || sig == SIGINT || sig == SIGHUP || sig == SIGQUIT;
 }
 
-int cal_parse_checkpoint_every(const char *command, const char *text, double *out)
-{
-    double v;
-    if (exp_parse_number(text, &v) || !(v >= 0 && v <= 86400))
-        return fprintf(stderr, "granucal %s: --checkpoint-every '%s': expected wall seconds in [0, 86400]\n", command,
-                       text), 2;
-    *out = v;
-    return 0;
-}
-
 // A drum run's checkpoint: beside its record, named by the same hash.
 static void checkpoint_path(const cal_env *env, const char *key, char *out, size_t len)
 {

@@ -44,10 +44,6 @@ void cal_env_set_stage(cal_env *env, const char *stage);
 /// most this much turning, and a save (a few MB at λ 1000) is a small share.
 #define CAL_CHECKPOINT_EVERY_S 120.0
 
-/// Parse a --checkpoint-every value (wall seconds, 0 = never, at most a day)
-/// into *out; 0, or 2 after a message naming the command and the value.
-int cal_parse_checkpoint_every(const char *command, const char *text, double *out);
-
 /// A drum candidate: the drum and powder, how its bed is settled, and how
 /// each speed is run.
 enum { CAL_CASE_MAX_RPM = 32 };

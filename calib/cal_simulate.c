@@ -3,13 +3,13 @@
 // config (drum, compression, silo, cylinder) goes to its runner through
 // simulate_runners; anything else is an explicit scene, run here and written
 // out frame by frame.
-#include <getopt.h>
 #include <libgen.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "cal_commands.h"
+#include "cal_options.h"
 #include "cal_sim.h"
 #include "cal_util.h"
 #include "exp_common.h"
@@ -20,7 +20,7 @@
 #include "exp_scene.h"
 #include "exp_silo.h"
 
-static const char simulate_help[] =
+static const char simulate_synopsis[] =
     "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"
     "                         [--checkpoint-every S]\n"
     "\n"
@@ -52,8 +52,9 @@ static const char simulate_help[] =
     "  granucal simulate configs/cylinder.yaml --set k_n=800 --set seed=2\n"
     "\n"
     "The confined compression test (configs/compression.yaml) and the silo discharge\n"
-    "(configs/silo.yaml) take --set and --out the same way (see those files).\n"
-    "\n"
+    "(configs/silo.yaml) take --set and --out the same way (see those files).\n";
+
+static const char simulate_epilogue[] =
     "An explicit scene (granules and walls listed one by one) writes, in DIR\n"
     "(default results/runs/<scene name>):\n"
     "  trajectory.csv  every granule every output_interval, columns\n"
@@ -233,30 +234,30 @@ static const struct simulate_runner {
     {exp_is_cylinder_config, run_cylinder},
 };
 
+enum { MAX_SETS = 64 };
+
 int cal_cmd_simulate(int argc, char **argv)
 {
-    static const struct option opts[] = {{"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'},
-                                         {"rpm-list", required_argument, 0, 'r'},
-                                         {"checkpoint-every", required_argument, 0, 'c'},
-                                         {"help", no_argument, 0, 'h'}, {0}};
-    char *sets[64];
+    char *sets[MAX_SETS];
     simulate_args a = {.sets = sets, .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
-    int c;
-    optind = 1, opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:s:h", opts, NULL)) != -1) {
-        if (c == 'h') return fputs(simulate_help, stdout), 0;
-        if (c == 'o') a.out = optarg;
-        else if (c == 's' && a.n_sets < 64) sets[a.n_sets++] = optarg;
-        else if (c == 'r') a.rpm_list = optarg;
-        else if (c == 'c') {
-            if (cal_parse_checkpoint_every("simulate", optarg, &a.checkpoint_every_s)) return 2;
-        } else if (c == 's') return fprintf(stderr, "granucal simulate: at most 64 --set options\n"), 2;
-        else return cal_option_error("simulate", c, argv);
-    }
-    if (optind != argc - 1)
-        return fprintf(stderr, "granucal simulate: give one SCENE.yaml%s; see `granucal simulate --help`\n",
-                       optind < argc ? ", not several" : ""), 2;
-    const char *path = argv[optind];
+    cal_option out = cal_option_out(&a.out, "results folder (default results/runs/<experiment or scene name>)");
+    out.short_name = 'o'; // -o has always been taken here
+    const cal_option table[] = {
+        {.name = "set", .short_name = 's', .kind = CAL_OPT_LIST, .list = sets, .count = &a.n_sets, .max = MAX_SETS,
+         .value = "KEY=VALUE", .help = "override a field of an experiment config (repeatable; the keys: above)"},
+        {.name = "rpm-list", .kind = CAL_OPT_TEXT, .text = &a.rpm_list, .value = "LIST",
+         .help = "a drum: turn one settled bed at each speed of LIST (4,40,80)"},
+        out,
+        cal_option_checkpoint_every(&a.checkpoint_every_s, "a drum: wall seconds between a turn's checkpoints "
+                                                           "(default 120; 0: none)"),
+    };
+    const cal_command_line line = {.command = "simulate", .synopsis = simulate_synopsis, .epilogue = simulate_epilogue,
+                                   .options = table, .n_options = sizeof table / sizeof *table,
+                                   .operand = "SCENE.yaml", .min_operands = 1, .max_operands = 1};
+    char **operands;
+    int n_operands, status = cal_options_parse(&line, argc, argv, &operands, &n_operands);
+    if (status) return status < 0 ? 0 : status;
+    const char *path = operands[0];
     for (size_t k = 0; k < sizeof simulate_runners / sizeof *simulate_runners; ++k)
         if (simulate_runners[k].claims(path)) return simulate_runners[k].run(path, &a);
     return run_scene_file(path, &a);

@@ -4,7 +4,6 @@
 // slice or full drum, run length, steady-state window and tolerance), several
 // seeds each, every simulation through the result store (resumable); then the
 // error of each rung against the finest rung run, against its wall time.
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +13,7 @@
 
 #include "cal_commands.h"
 #include "cal_mpi.h"
+#include "cal_options.h"
 #include "cal_plan.h"
 #include "cal_sim.h"
 #include "cal_util.h"
@@ -24,7 +24,7 @@
 #include <omp.h>
 #endif
 
-static const char help[] =
+static const char synopsis[] =
     "usage: granucal study fidelity [CONFIG.yaml] [options]\n"
     "\n"
     "Runs the drum lined with granules at the config's granule-granule pair (Table 3:\n"
@@ -40,29 +40,9 @@ static const char help[] =
     "\n"
     "A rung whose predicted wall time exceeds the budget left is not run; its prediction\n"
     "(scaled from the largest rung run: granules ~ depth / lambda, steps ~ lambda^(-1/6)\n"
-    "since eq. 16-17 keep the granule mass, so dt_crit ~ lambda^(1/6)) is listed instead.\n"
-    "\n"
-    "options:\n"
-    "  --out DIR            results folder (default results/fidelity)\n"
-    "  --report DIR         write fidelity.md, its CSVs and plots into DIR instead of\n"
-    "                       OUT (the runs still go to OUT/store): a few rungs or speeds\n"
-    "                       reported beside the ladder's own fidelity.md, not over it\n"
-    "  --budget-hours H     replaces fidelity.budget_hours\n"
-    "  --seeds N            replaces fidelity.seeds (1-16)\n"
-    "  --rungs A,B,...      only these rungs, in config order (a name not in the ladder\n"
-    "                       is refused); without it every rung, which needs --yes\n"
-    "  --rpm A,B,...        only these of fidelity.rpm (e.g. --rpm 4 to narrow the\n"
-    "                       4 rpm angle's error first; default: every speed)\n"
-    "  --jobs N             simulations side by side (default: cores)\n"
-    "  --checkpoint-every S wall seconds between a drum run's checkpoints (default 120;\n"
-    "                       0: none); a killed study, run again, resumes each turn\n"
-    "  --plan               check the config, print the plan (each rung's drum runs,\n"
-    "                       core-hours and wall hours on --jobs workers, expected and\n"
-    "                       worst case, and which fit the budget) and stop: nothing runs\n"
-    "  --yes                run every rung: without --rungs the study prints its plan\n"
-    "                       and stops with exit status 2 (the whole ladder is many hours)\n"
-    "  -h, --help           this text\n"
-    "\n"
+    "since eq. 16-17 keep the granule mass, so dt_crit ~ lambda^(1/6)) is listed instead.\n";
+
+static const char epilogue[] =
     "Outputs in DIR: fidelity.csv (rung x speed), fidelity_summary.csv (rung),\n"
     "fidelity.md, fidelity_error_vs_cost.png, fidelity_vs_lambda.png (or, where every\n"
     "rung run has one lambda, fidelity_vs_slice_depth.png), store/.\n"
@@ -85,7 +65,7 @@ typedef struct options {
 } options;
 
 typedef struct rung_result {
-    const cal_rung *rung;
+    const cal_tier *rung;
     int ran;                     ///< 1 measured, 0 skipped (predicted only)
     double predicted_s;          ///< wall time predicted before running (NAN: no basis yet)
     double depth;                ///< m, slice or full drum
@@ -109,51 +89,38 @@ typedef struct study {
     char err[2048];
 } study;
 
+// 0: parsed; -1: --help printed; else the exit status of a usage error.
 static int parse_options(int argc, char **argv, options *o)
 {
-    static const struct option longs[] = {{"out", required_argument, 0, 'o'}, {"budget-hours", required_argument, 0, 'b'},
-                                          {"rungs", required_argument, 0, 'r'}, {"jobs", required_argument, 0, 'j'},
-                                          {"seeds", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
-                                          {"checkpoint-every", required_argument, 0, 'c'}, {"rpm", required_argument, 0, 'm'},
-                                          {"report", required_argument, 0, 'p'}, {"plan", no_argument, 0, 'P'},
-                                          {"yes", no_argument, 0, 'y'}, {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .out = "results/fidelity", .budget_hours = NAN,
-                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
-    optind = 1, opterr = 0;
-    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
-        double v = NAN;
-        switch (ch) {
-        case 'o': o->out = optarg; break;
-        case 'p': o->report = optarg; break;
-        case 'P': o->plan_only = 1; break;
-        case 'y': o->yes = 1; break;
-        case 'r': o->rungs = optarg; break;
-        case 'm': o->rpm = optarg; break;
-        case 'b':
-            if (exp_parse_number(optarg, &o->budget_hours) || !(o->budget_hours > 0))
-                return fprintf(stderr, "granucal study: --budget-hours '%s': need a number > 0\n", optarg), 2;
-            break;
-        case 'j':
-            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 4096))
-                return fprintf(stderr, "granucal study: --jobs '%s': need an integer in [1, 4096]\n", optarg), 2;
-            o->jobs = (int)v;
-            break;
-        case 's':
-            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 16))
-                return fprintf(stderr, "granucal study: --seeds '%s': need an integer in [1, 16]\n", optarg), 2;
-            o->seeds = (int)v;
-            break;
-        case 'c':
-            if (cal_parse_checkpoint_every("study", optarg, &o->checkpoint_every_s)) return 2;
-            break;
-        case 'h': fputs(help, stdout); return -1;
-        default: return cal_option_error("study fidelity", ch, argv);
-        }
-    }
-    if (optind < argc) o->config = argv[optind++];
-    if (optind < argc) return fprintf(stderr, "granucal study: unexpected argument '%s'\n", argv[optind]), 2;
-    if (o->jobs < 1) o->jobs = 1;
-    return 0;
+                   .jobs = cal_default_jobs(), .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
+    const cal_option table[] = {
+        cal_option_out(&o->out, "results folder (default results/fidelity)"),
+        {.name = "report", .kind = CAL_OPT_TEXT, .text = &o->report, .value = "DIR",
+         .help = "write fidelity.md, its CSVs and plots into DIR instead of OUT (the runs still go to OUT/store): a "
+                 "few rungs or speeds reported beside the ladder's own fidelity.md, not over it"},
+        cal_option_budget_hours(&o->budget_hours, "replaces fidelity.budget_hours"),
+        {.name = "seeds", .kind = CAL_OPT_INT, .integer = &o->seeds, .lo = 1, .hi = MAX_SEEDS, .value = "N",
+         .help = "replaces fidelity.seeds"},
+        {.name = "rungs", .kind = CAL_OPT_TEXT, .text = &o->rungs, .value = "A,B,...",
+         .help = "only these rungs, in config order (a name not in the ladder is refused); without it every rung, "
+                 "which needs --yes"},
+        {.name = "rpm", .kind = CAL_OPT_TEXT, .text = &o->rpm, .value = "A,B,...",
+         .help = "only these of fidelity.rpm (e.g. --rpm 4 to narrow the 4 rpm angle's error first; default: every "
+                 "speed)"},
+        cal_option_jobs(&o->jobs),
+        cal_option_checkpoint_every(&o->checkpoint_every_s, "wall seconds between a drum run's checkpoints (default "
+                                                            "120; 0: none); a killed study, run again, resumes each turn"),
+        cal_option_plan(&o->plan_only, "check the config, print the plan (each rung's drum runs, core-hours and wall "
+                                       "hours on --jobs workers, expected and worst case, and which fit the budget) "
+                                       "and stop: nothing runs"),
+        {.name = "yes", .kind = CAL_OPT_FLAG, .flag = &o->yes, .set_to = 1,
+         .help = "run every rung: without --rungs the study prints its plan and stops with exit status 2 (the whole "
+                 "ladder is many hours)"},
+    };
+    const cal_command_line line = {.command = "study fidelity", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 static int wanted(const char *list, const char *name)
@@ -207,26 +174,17 @@ static int narrow_speeds(cal_fidelity *f, const char *list, const char *path, ch
     return n ? 0 : exp_fail(err, len, "--rpm '%s': no speed given", list);
 }
 
-/// The rung as a calibration tier (the drum case takes one).
-static cal_tier tier_of(const cal_rung *r)
+// A rung is a tier with the drum's knobs alone (cal_config.h): its drum case
+// is the calibration's at the config's granule pair.
+static cal_drum_case case_of(const study *s, const cal_tier *r, int seed)
 {
-    return (cal_tier){.name = r->name, .lambda = r->lambda, .slice_depth = r->slice_depth, .max_time = r->max_time,
-                      .window = r->window, .sample_interval = r->sample_interval,
-                      .steady_angle_tol_deg = r->steady_angle_tol_deg,
-                      .steady_csa_tol_percent = r->steady_csa_tol_percent, .fill_method = r->fill_method,
-                      .average_time = r->average_time};
-}
-
-static cal_drum_case case_of(const study *s, const cal_rung *r, int seed)
-{
-    cal_tier t = tier_of(r);
-    cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+    cal_drum_case d = cal_drum_case_granule(s->c, r, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
     d.def.seed = d.fill.seed = (uint64_t)(s->c->seed + seed);
     return d;
 }
 
 // 1 if every simulation of the rung is already in the store.
-static int all_stored(const study *s, const cal_rung *r)
+static int all_stored(const study *s, const cal_tier *r)
 {
     const cal_fidelity *f = s->c->fidelity;
     for (int seed = 0; seed < f->seeds; ++seed) {
@@ -246,7 +204,7 @@ static int all_stored(const study *s, const cal_rung *r)
 // second ~ 1/dt ~ lambda^(-1/6) (eq. 14 with eq. 16-17: the coarse granule
 // keeps the mass, the stiffness falls as lambda^(-1/3)), simulated time ~
 // speeds x max_time plus the fill (about 3 s of settling whatever lambda).
-static double predict_wall(const rung_result *base, const cal_rung *r, double depth)
+static double predict_wall(const rung_result *base, const cal_tier *r, double depth)
 {
     const double fill_s = 3.0;
     double n = base->granules * (base->rung->lambda / r->lambda) * (depth / base->depth);
@@ -277,11 +235,10 @@ static double print_plan(const study *s)
     fprintf(stderr, "== plan: study fidelity, %d seed(s) x %u speed(s) a rung, %d worker(s); expected (worst case)\n", f->seeds,
             f->rpm_count, parallel);
     for (unsigned k = 0; k < f->rungs_count; ++k) {
-        const cal_rung *rung = &f->rungs[k];
+        const cal_tier *rung = &f->rungs[k];
         if (!wanted(s->opt.rungs, rung->name)) continue;
         cal_plan p = {{0}, {0}};
-        cal_tier t = tier_of(rung);
-        cal_drum_case d = cal_drum_case_granule(s->c, &t, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
+        cal_drum_case d = cal_drum_case_granule(s->c, rung, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
         for (int w = 0; w < 2; ++w)
             cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w);
         int fits = spent + p.expected.wall_s <= budget_s;
@@ -725,7 +682,7 @@ static int run_ladder(study *s)
     const cal_fidelity *f = s->c->fidelity;
     double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
     for (unsigned k = 0; k < f->rungs_count && s->n < MAX_RUNGS; ++k) {
-        const cal_rung *rung = &f->rungs[k];
+        const cal_tier *rung = &f->rungs[k];
         if (!wanted(s->opt.rungs, rung->name)) continue;
         rung_result *r = &s->res[s->n++];
         memset(r, 0, sizeof *r);
@@ -753,14 +710,15 @@ static int run_ladder(study *s)
 
 int cal_cmd_study(int argc, char **argv)
 {
-    if (argc < 2 || strcmp(argv[1], "fidelity") != 0) {
-        if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) return fputs(help, stdout), 0;
+    int asks_help = argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0);
+    if (!asks_help && (argc < 2 || strcmp(argv[1], "fidelity") != 0)) {
         fprintf(stderr, "granucal study: the study to run is `fidelity`; see `granucal study --help`\n");
         return 2;
     }
     study *s = calloc(1, sizeof *s);
     if (!s) return fputs("granucal study: out of memory\n", stderr), 1;
-    int status = parse_options(argc - 1, argv + 1, &s->opt);
+    // `study --help` is the fidelity study's: the one study there is.
+    int status = asks_help ? parse_options(argc, argv, &s->opt) : parse_options(argc - 1, argv + 1, &s->opt);
     if (status) return free(s), status < 0 ? 0 : status;
     char command[2048] = "granucal";
     for (int k = 0; k < argc; ++k) snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);

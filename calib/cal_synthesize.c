@@ -8,7 +8,6 @@
 // differ from any candidate's run by the tier's seed noise, as lab data
 // differ from the model by the powder's.
 #include <errno.h>
-#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +18,7 @@
 #include "cal_commands.h"
 #include "cal_data.h"
 #include "cal_mpi.h"
+#include "cal_options.h"
 #include "cal_plan.h"
 #include "cal_sim.h"
 #include "cal_stages.h"
@@ -32,7 +32,7 @@
 
 enum { MAX_SEEDS = 16, MAX_WALLS = 16 };
 
-static const char help[] =
+static const char synopsis[] =
     "usage: granucal synthesize [CONFIG.yaml] [options]\n"
     "\n"
     "Makes the two data files a calibration reads (repose_angle.csv, occupied_area.csv)\n"
@@ -43,27 +43,9 @@ static const char help[] =
     "\n"
     "A twin experiment: `granucal calibrate --data DIR` on these files must recover the\n"
     "pairs inside the ranges it reports; what it cannot recover, the tier cannot identify.\n"
-    "The files say SYNTHETIC in their header with the command, version and seeds.\n"
-    "\n"
-    "options:\n"
-    "  --tier NAME           fidelity tier whose drum is run (default: the config's)\n"
-    "  --granule MU_S,MU_R   granule-granule pair (default: granule_mu_s, granule_mu_r)\n"
-    "  --wall NAME=MU_S,MU_R a wall material's pair, one option per material; a config\n"
-    "                        material without one is refused (its data would be missing)\n"
-    "  --k-n K               granule stiffness, N/m (default: the config's k_n)\n"
-    "  --seeds A,B,...       drum seeds (default 101,102,103; the config's seed, which the\n"
-    "                        calibration's candidates use, is refused)\n"
-    "  --out DIR             (default results/synthetic-<tier>); runs kept in DIR/store\n"
-    "  --reuse STORE         another run's store (e.g. a fidelity study's) to take\n"
-    "                        records from: a simulation found there under the same key\n"
-    "                        (drum, pairs, seed, speed, tier, results version) is\n"
-    "                        copied into DIR/store byte for byte, not run again\n"
-    "  --jobs N              simulations side by side (default: cores)\n"
-    "  --plan                check every input, print the plan (drum runs, core-hours and\n"
-    "                        wall hours on --jobs workers, expected and worst case) and\n"
-    "                        stop: nothing runs, no folder is made\n"
-    "  -h, --help            this text\n"
-    "\n"
+    "The files say SYNTHETIC in their header with the command, version and seeds.\n";
+
+static const char epilogue[] =
     "Each value is the mean over the seeds whose run is usable; its spread column is the\n"
     "standard error of that mean (sd over seeds / sqrt(n)), floored at 0.05.\n";
 
@@ -91,8 +73,10 @@ static int parse_pair(const char *text, double *mu_s, double *mu_r)
     return end == second || *end || !(*mu_s > 0) || !(*mu_r > 0) || !isfinite(*mu_s) || !isfinite(*mu_r);
 }
 
-static int parse_seeds(const char *text, options *o)
+// --seeds A,B,...: 1-16 whole numbers.
+static int take_seeds(const char *text, void *context)
 {
+    options *o = context;
     char copy[256];
     snprintf(copy, sizeof copy, "%s", text);
     o->n_seeds = 0;
@@ -104,61 +88,60 @@ static int parse_seeds(const char *text, options *o)
     return o->n_seeds == 0;
 }
 
-static int bad_option(const char *name, const char *value, const char *want)
+// --granule MU_S,MU_R
+static int take_granule(const char *text, void *context)
 {
-    fprintf(stderr, "granucal synthesize: %s '%s': %s\n", name, value, want);
-    return 2;
+    options *o = context;
+    o->has_granule = 1;
+    return parse_pair(text, &o->granule.mu_s, &o->granule.mu_r);
 }
 
+// --wall NAME=MU_S,MU_R, one a material
+static int take_wall(const char *text, void *context)
+{
+    options *o = context;
+    const char *eq = strchr(text, '=');
+    pair *p = &o->walls[o->n_walls];
+    if (o->n_walls == MAX_WALLS || !eq || eq == text || (size_t)(eq - text) >= sizeof p->name ||
+        parse_pair(eq + 1, &p->mu_s, &p->mu_r))
+        return 1;
+    snprintf(p->name, sizeof p->name, "%.*s", (int)(eq - text), text);
+    o->n_walls++;
+    return 0;
+}
+
+// 0: parsed; -1: --help printed; else the exit status of a usage error.
 static int parse_options(int argc, char **argv, options *o)
 {
-    static const struct option longs[] = {{"tier", 1, 0, 't'},  {"granule", 1, 0, 'g'}, {"wall", 1, 0, 'w'},
-                                          {"k-n", 1, 0, 'k'},   {"seeds", 1, 0, 's'},   {"out", 1, 0, 'o'},
-                                          {"jobs", 1, 0, 'j'},  {"help", 0, 0, 'h'},    {"reuse", 1, 0, 'r'},
-                                          {"plan", 0, 0, 'p'},    {0, 0, 0, 0}};
     *o = (options){.config = "configs/calibration.yaml", .k_n = NAN, .n_seeds = 3, .seeds = {101, 102, 103},
-                   .jobs = (int)sysconf(_SC_NPROCESSORS_ONLN)};
-    optind = 1, opterr = 0;
-    for (int ch; (ch = getopt_long(argc, argv, ":h", longs, NULL)) != -1;) {
-        double v;
-        switch (ch) {
-        case 't': o->tier = optarg; break;
-        case 'o': o->out = optarg; break;
-        case 'r': o->reuse = optarg; break;
-        case 'p': o->plan_only = 1; break;
-        case 'g':
-            if (parse_pair(optarg, &o->granule.mu_s, &o->granule.mu_r))
-                return bad_option("--granule", optarg, "need MU_S,MU_R, both > 0");
-            o->has_granule = 1;
-            break;
-        case 'w': {
-            const char *eq = strchr(optarg, '=');
-            pair *p = &o->walls[o->n_walls];
-            if (o->n_walls == MAX_WALLS || !eq || eq == optarg || (size_t)(eq - optarg) >= sizeof p->name ||
-                parse_pair(eq + 1, &p->mu_s, &p->mu_r))
-                return bad_option("--wall", optarg, "need NAME=MU_S,MU_R, both > 0");
-            snprintf(p->name, sizeof p->name, "%.*s", (int)(eq - optarg), optarg);
-            o->n_walls++;
-            break;
-        }
-        case 'k':
-            if (exp_parse_number(optarg, &o->k_n) || !(o->k_n > 0)) return bad_option("--k-n", optarg, "need a stiffness > 0 N/m");
-            break;
-        case 's':
-            if (parse_seeds(optarg, o)) return bad_option("--seeds", optarg, "need 1-16 whole numbers separated by commas");
-            break;
-        case 'j':
-            if (exp_parse_number(optarg, &v) || !exp_integer_in(v, 1, 1024)) return bad_option("--jobs", optarg, "need 1..1024");
-            o->jobs = (int)v;
-            break;
-        case 'h': fputs(help, stdout); return -1;
-        default: return cal_option_error("synthesize", ch, argv);
-        }
-    }
-    if (optind < argc) o->config = argv[optind++];
-    if (optind < argc) return fprintf(stderr, "granucal synthesize: unexpected argument '%s'\n", argv[optind]), 2;
-    if (o->jobs < 1) o->jobs = 1;
-    return 0;
+                   .jobs = cal_default_jobs()};
+    const cal_option table[] = {
+        cal_option_tier(&o->tier, "fidelity tier whose drum is run (default: the config's)"),
+        {.name = "granule", .kind = CAL_OPT_CUSTOM, .parse = take_granule, .context = o, .value = "MU_S,MU_R",
+         .expected = "MU_S,MU_R, both > 0", .help = "granule-granule pair (default: granule_mu_s, granule_mu_r)"},
+        {.name = "wall", .kind = CAL_OPT_CUSTOM, .parse = take_wall, .context = o, .value = "NAME=MU_S,MU_R",
+         .expected = "NAME=MU_S,MU_R, both > 0 (at most 16 materials)",
+         .help = "a wall material's pair, one option per material; a config material without one is refused (its "
+                 "data would be missing)"},
+        {.name = "k-n", .kind = CAL_OPT_REAL, .real = &o->k_n, .lo = 0, .lo_open = 1, .hi = INFINITY, .value = "K",
+         .expected = "a stiffness in N/m", .help = "granule stiffness, N/m (default: the config's k_n)"},
+        {.name = "seeds", .kind = CAL_OPT_CUSTOM, .parse = take_seeds, .context = o, .value = "A,B,...",
+         .expected = "1-16 whole numbers separated by commas",
+         .help = "drum seeds (default 101,102,103; the config's seed, which the calibration's candidates use, is "
+                 "refused)"},
+        cal_option_out(&o->out, "(default results/synthetic-<tier>); runs kept in DIR/store"),
+        {.name = "reuse", .kind = CAL_OPT_TEXT, .text = &o->reuse, .value = "STORE",
+         .help = "another run's store (e.g. a fidelity study's) to take records from: a simulation found there "
+                 "under the same key (drum, pairs, seed, speed, tier, results version) is copied into DIR/store "
+                 "byte for byte, not run again"},
+        cal_option_jobs(&o->jobs),
+        cal_option_plan(&o->plan_only, "check every input, print the plan (drum runs, core-hours and wall hours on "
+                                       "--jobs workers, expected and worst case) and stop: nothing runs, no folder "
+                                       "is made"),
+    };
+    const cal_command_line line = {.command = "synthesize", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
 }
 
 /// One drum lining to make: its surface name in the data files and its cases.

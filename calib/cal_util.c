@@ -4,7 +4,6 @@
 #include "exp_common.h"
 
 #include <dirent.h>
-#include <getopt.h>
 #include <errno.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -27,17 +26,6 @@ void cal_host_name(char host[64])
     snprintf(host, 64, "host");
     gethostname(host, 63);
     host[63] = 0;
-}
-
-int cal_option_error(const char *command, int code, char *const argv[])
-{
-    const char *arg = optind > 0 ? argv[optind - 1] : "";
-    char shown[80];
-    if (optopt > 0 && optopt < 128 && strncmp(arg, "--", 2) != 0) snprintf(shown, sizeof shown, "-%c", optopt);
-    else snprintf(shown, sizeof shown, "%.*s", (int)strcspn(arg, "="), arg); // "--name=value": the name
-    fprintf(stderr, "granucal %s: %s '%s'; see `granucal %s --help`\n", command,
-            code == ':' ? "a value is missing after" : "unknown option", shown, command);
-    return 2;
 }
 
 void cal_temporary_name(const char *path, char *tmp, size_t len)

@@ -44,12 +44,6 @@ int cal_copy_file(const char *from, const char *to, char *err, size_t err_len);
 /// Returns how many were removed.
 int cal_atomic_sweep(const char *dir);
 
-/// A command's option that getopt_long refused (it returned '?' or ':', with
-/// opterr = 0 and an optstring starting with ':'): one line naming the option
-/// and where the options are described, on stderr. Returns 2, the exit status
-/// of a usage error.
-int cal_option_error(const char *command, int code, char *const argv[]);
-
 /// The commit the binary was built from ("git describe --dirty" at build
 /// time), for the provenance line of files a run writes.
 const char *cal_build_commit(void);

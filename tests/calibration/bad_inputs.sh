@@ -59,6 +59,10 @@ expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its
 expect "unknown tier in the file" "good_tier.yaml:$(grep -n '^tier:' "$work/configs/good.yaml" | cut -d: -f1): tier: 'fast' is not one of its tiers: $tiers" -- "$(edit good_tier 's/^tier: quick/tier: fast/')" "${out[@]}"
 cmd=synthesize expect "synthesize: unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
 cmd=study expect "study: unknown rung" "--rungs L1000-slice9-avg8,L3-full: 'L3-full' is not a rung of $work/configs/good.yaml (fidelity.rungs); its rungs: L65536-slice40, " -- fidelity "$work/configs/good.yaml" --rungs L1000-slice9-avg8,L3-full "${out[@]}"
+# A tier and a rung are one struct and one schema (cal_tier): a rung may not give a tier's own
+# keys, and a tier may not leave out those it needs (optional in the schema, for the rungs).
+cmd=study expect "rung with a tier's key" "grid: a key of a calibration tier: a rung takes the drum's" -- fidelity "$(edit rung_grid 's/{name: L4096-slice15, lambda/{name: L4096-slice15, grid: 3, lambda/')" --rungs L4096-slice15 --plan "${out[@]}"
+expect "tier without seeds" "seeds: a calibration tier needs it" -- "$(edit no_seeds '0,/^    seeds: 2/{/^    seeds: 2/d}')" --plan "${out[@]}"
 # A measured size table (gsd_table): its rows checked and named; not with the log-normal's keys; its basis required.
 printf 'size_um,cumulative_percent\n100,0\n200,40\n300,30\n400,100\n' > "$work/configs/psd.csv"
 expect "size table decreasing" "psd.csv:4: cumulative_percent: 30 is below the row above (40)" -- "$(edit psd 's/^median_diameter: .*/gsd_table: psd.csv\ngsd_basis: volume/; /^geometric_sd:/d; /^truncation_sigmas:/d')" "${out[@]}"
@@ -85,7 +89,7 @@ expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"
-cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': need NAME=MU_S,MU_R" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
+cmd=synthesize expect "twin: a pair not a pair" "--wall 'PP=0.9': expected NAME=MU_S,MU_R, both > 0" -- "$work/configs/good.yaml" --wall PP=0.9 "${out[@]}"
 cmd=synthesize expect "twin: a wall not in the config" "--wall granite: not a material" -- "$work/configs/good.yaml" "${walls[@]}" --wall granite=0.5,0.1 "${out[@]}"
 cmd=synthesize expect "twin: on the candidates' own bed" "--seeds: 2 is a bed of" -- "$work/configs/good.yaml" "${walls[@]}" --tier ci --seeds 2,101 "${out[@]}"
 # --plan checks every input as a run would (a bad one still fails), prints the plan, and
@@ -107,6 +111,28 @@ for c in calibrate simulate measure "study fidelity" synthesize; do
     else echo "FAIL $c $bad: exit $code, wanted one line naming '$bad' and \`granucal $c --help\`: $msg"; fails=$((fails + 1)); fi
   done
 done
+# A bad value of any command's option (calib/cal_options.c reads them all from each command's
+# table): one line naming the option, the value and what it accepts, exit 2; the help lists it.
+usage_error() { # usage_error WANT ARGS...: exit 2, one line on stderr holding WANT
+  local want=$1; shift
+  msg=$(timeout 20 "$bin" "$@" 2>&1 >/dev/null); code=$?
+  if [ $code -eq 2 ] && [ "$(wc -l <<< "$msg")" -eq 1 ] && grep -qF -- "$want" <<< "$msg"; then echo "ok   $*: $msg"
+  else echo "FAIL $*: exit $code, wanted one line with '$want': $msg"; fails=$((fails + 1)); fi
+}
+for c in calibrate "study fidelity" synthesize; do
+  usage_error "granucal $c: --jobs '0': expected a whole number in 1..1024" $c --jobs 0
+  help=$(timeout 20 "$bin" $c --help); code=$?
+  if [ $code -eq 0 ] && grep -q -- "--jobs N .*accepts a whole number in 1..1024" <<< "$(tr -s ' \n' ' ' <<< "$help")"; then
+    echo "ok   $c --help: lists --jobs with its range"
+  else echo "FAIL $c --help: exit $code, no '--jobs N ... accepts a whole number in 1..1024'"; fails=$((fails + 1)); fi
+done
+usage_error "granucal simulate: --checkpoint-every '-1': expected wall seconds in [0, 86400]" simulate "$src/configs/drum.yaml" --checkpoint-every -1
+usage_error "granucal study fidelity: --seeds '17': expected a whole number in 1..16" study fidelity --seeds 17
+usage_error "granucal measure: --radius 'wide': expected a radius in pixels > 0" measure photo.png --radius wide
+usage_error "granucal synthesize: --k-n '0': expected a stiffness in N/m > 0" synthesize --k-n 0
+usage_error "granucal calibrate: --stage 'polish': expected all, stiffness, granule or wall" calibrate --stage polish
+usage_error "granucal simulate: no SCENE.yaml given; see \`granucal simulate --help\`" simulate
+usage_error "granucal calibrate: unexpected argument 'b.yaml'; see \`granucal calibrate --help\`" calibrate a.yaml b.yaml
 # A wall lining the drum config does not have: the error lists those it has.
 drum_walls=$(sed -n 's/^  - {name: \([^,]*\),.*/\1/p' "$src/configs/drum.yaml" | paste -sd, | sed 's/,/, /g')
 cmd=simulate expect "unknown wall material" "wall = 'Steel': not 'granules' nor a name under materials; the walls are: granules, $drum_walls" -- "$src/configs/drum.yaml" --set wall=Steel --out "$work/out"

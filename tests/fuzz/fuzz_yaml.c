@@ -87,7 +87,7 @@ static void check_config(const cal_config *c, const char *path)
         finite(L, "fidelity.budget_hours", f->budget_hours);
         for (unsigned j = 0; j < f->rpm_count; ++j) finite(L, "fidelity.rpm", f->rpm[j]);
         for (unsigned k = 0; k < f->rungs_count; ++k) {
-            const cal_rung *r = &f->rungs[k];
+            const cal_tier *r = &f->rungs[k];
             finite(L, "rung lambda", r->lambda), finite(L, "rung slice_depth", r->slice_depth);
             finite(L, "rung max_time", r->max_time), finite(L, "rung window", r->window);
             finite(L, "rung sample_interval", r->sample_interval);
