@@ -65,8 +65,11 @@ def includes(path):
 
 
 def skipped(path):
-    """A hidden folder, or a build tree (one with a CMakeCache.txt): not source."""
-    return os.path.basename(path).startswith(".") or os.path.exists(os.path.join(path, "CMakeCache.txt"))
+    """A hidden folder, a build tree (one with a CMakeCache.txt) or a build* folder (.gitignore's
+    build*/: what a script exports there, such as vs_peers.sh's copy of the sources, is not this tree's
+    source): not source."""
+    name = os.path.basename(path)
+    return name.startswith((".", "build")) or os.path.exists(os.path.join(path, "CMakeCache.txt"))
 
 
 def sources(root, top):
