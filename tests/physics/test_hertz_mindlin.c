@@ -13,7 +13,7 @@
 //   5. the coarse-graining rule keeps the relative overlap under one force;
 //   6. a configured step above the Rayleigh limit is refused.
 //
-// Hertz's impact (Johnson 1985, sec. 11.4): m* ḧ = −(4/3) E* sqrt(R*) h^(3/2)
+// Hertz's impact (Johnson 1985, ch. 11): m* ḧ = −(4/3) E* sqrt(R*) h^(3/2)
 // from ḣ = v. Energy: ½ m* v² = (8/15) E* sqrt(R*) h_max^(5/2), so
 //   h_max = (15 m* v² / (16 E* sqrt(R*)))^(2/5);
 // and t_c = 2 (h_max/v) ∫₀¹ dx / sqrt(1 − x^(5/2)) = 2 (h_max/v) (2/5)
