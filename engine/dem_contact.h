@@ -277,7 +277,7 @@ typedef struct dem_contact_drive {
 } dem_contact_drive;
 
 /// The Hertz–Mindlin normal stage, with a = sqrt(R* h) the contact radius:
-/// F_n = (4/3) E* a h (Hertz 1882; Johnson 1985, eq. 4.22), the dashpot
+/// F_n = (4/3) E* a h (Hertz 1882; Johnson 1985, sec. 4.2), the dashpot
 /// γ_n = 2 sqrt(5/6) ξ sqrt(S_n m*) with S_n = 2 E* a (Tsuji et al. 1992, in
 /// the form of LIGGGHTS and Antypov & Elliott 2011), and Mindlin's (1949)
 /// no-slip tangential stiffness k_t = 8 G* a. Returns the elastic force;
