@@ -1,13 +1,21 @@
 // SPDX-License-Identifier: MIT
 /// @file dem_contact.h
-/// The linear spring–dashpot (LSD) contact law of Tiscar et al. (2019),
-/// section 2.1, as one stateless kernel shared by granule–granule and
+/// The contact law as one stateless kernel shared by granule–granule and
 /// granule–wall contacts (a wall is a granule of infinite mass and radius:
 /// the caller passes m* = m_i and R* = R_i, and nothing here branches on it).
+/// Two laws, each a set of sub-models named by its descriptor
+/// (dem_contact_model, dem_contact_model_of):
+///  - DEM_LAW_LINEAR, the default: the linear spring–dashpot (LSD) of Tiscar
+///    et al. (2019), section 2.1 (eq. 3–13, docs/model.md);
+///  - DEM_LAW_HERTZ_MINDLIN: Hertz normal spring, Tsuji-type dashpot, Mindlin
+///    no-slip tangential spring; the same rolling spring (docs/model.md,
+///    "Hertz–Mindlin").
 ///
 /// The kernel is `static inline` and takes a feature mask that is a
 /// compile-time constant at every call site in the force loops, so the
 /// compiler removes every effect a scene does not use (see dem_features).
+/// The law is one bit of that mask (DEM_FEAT_HERTZ): the force loops pick
+/// their instantiation once per world or wall, and no contact tests the law.
 #ifndef DEM_CONTACT_H
 #define DEM_CONTACT_H
 
@@ -22,9 +30,24 @@ enum dem_feature {
     DEM_FEAT_DAMPING = 1u << 0,    ///< normal dashpot, eq. 3–4
     DEM_FEAT_TANGENTIAL = 1u << 1, ///< tangential spring with history, eq. 6–8
     DEM_FEAT_ROLLING = 1u << 2,    ///< rolling quasi-force spring, eq. 11–13
-    DEM_FEAT_PERIODIC = 1u << 3,   ///< one periodic axis (loop level, not kernel)
-    DEM_FEAT_COUNT_MASKS = 1u << 4
+    DEM_FEAT_HERTZ = 1u << 3,      ///< the Hertz–Mindlin law's normal, dashpot and tangential stages
+    DEM_FEAT_KERNEL_MASKS = 1u << 4, ///< masks the kernel reads (the bits above)
+    DEM_FEAT_PERIODIC = 1u << 4,   ///< one periodic axis (loop level, not kernel)
+    DEM_FEAT_COUNT_MASKS = 1u << 5
 };
+
+/// The contact law: which sub-models (normal, damping, tangential, rolling)
+/// the kernel runs. Zero, the default, is the paper's law.
+typedef enum dem_contact_law {
+    /// Tiscar et al. (2019): linear normal spring k_n (eq. 3), dashpot
+    /// 2ξ sqrt(m* k_n) (eq. 4), linear tangential spring k_s (eq. 6–8).
+    DEM_LAW_LINEAR = 0,
+    /// Hertz (1882) normal force (4/3) E* sqrt(R*) h^(3/2); Tsuji et al.
+    /// (1992) dashpot 2 sqrt(5/6) ξ sqrt(S_n m*), S_n = 2 E* sqrt(R* h);
+    /// Mindlin (1949) no-slip tangential stiffness 8 G* sqrt(R* h).
+    DEM_LAW_HERTZ_MINDLIN = 1,
+    DEM_LAW_COUNT = 2
+} dem_contact_law;
 
 /// Which sign of the normal relative velocity switches the dashpot of eq. 4
 /// on. The equation, read literally with the sign conventions of eq. 3 and 5
@@ -49,14 +72,26 @@ typedef enum dem_damping_mode {
 
 /// Parameters of one contact kind (granule–granule, or granule–one wall
 /// material), in SI units. Table 3 gives the paper's calibrated values.
+/// The linear law reads k_n and k_s, the Hertz–Mindlin law E* and G*
+/// instead (the other pair must be 0); both read the rest.
 typedef struct dem_contact_params {
     double k_n;  ///< normal stiffness, N/m (eq. 3)
     double k_s;  ///< tangential stiffness, N/m (eq. 6)
     double k_r;  ///< rolling stiffness, N/m (eq. 11)
-    double xi;   ///< damping ratio ξ (eq. 4)
+    /// Damping ratio ξ (eq. 4). For either law, with the dashpot on in both
+    /// phases (DEM_DAMPING_ALWAYS), the restitution of a head-on collision
+    /// is e = exp(−πξ/sqrt(1−ξ²)) (Hertz: Antypov & Elliott 2011).
+    double xi;
     double mu_s; ///< sliding friction coefficient (eq. 8)
     double mu_r; ///< rolling friction coefficient (eq. 13)
     dem_damping_mode damping;
+    dem_contact_law law;  ///< default DEM_LAW_LINEAR
+    /// Hertz–Mindlin only: effective modulus E*, Pa, with 1/E* = (1−ν_i²)/E_i
+    /// + (1−ν_j²)/E_j (a wall: its own E and ν, or E = ∞ for a rigid one).
+    double youngs_modulus;
+    /// Hertz–Mindlin only: effective shear modulus G*, Pa, with 1/G* =
+    /// (2−ν_i)/G_i + (2−ν_j)/G_j; 0 switches the tangential spring off.
+    double shear_modulus;
 } dem_contact_params;
 
 /// Coefficients the kernel needs, derived once from dem_contact_params so the
@@ -69,6 +104,10 @@ typedef struct dem_contact_coeffs {
     double damp_approaching;  ///< 1 if the dashpot acts while approaching
     double damp_separating;   ///< 1 if the dashpot acts while separating
     double clamp_tension;     ///< 1 to clamp the normal force at zero
+    // Hertz–Mindlin (DEM_FEAT_HERTZ), with a = sqrt(R* h) the contact radius:
+    double hertz_kn;   ///< (4/3) E*: F_n = hertz_kn·a·h
+    double hertz_kt;   ///< 8 G*: k_t = hertz_kt·a (Mindlin 1949)
+    double hertz_damp; ///< 2 sqrt(5/6) ξ sqrt(2 E*): γ_n = hertz_damp·sqrt(a)·sqrt(m*)
 } dem_contact_coeffs;
 
 /// Geometry and kinematics of one contact at the current step.
@@ -111,6 +150,47 @@ static inline int dem_same_history_layout(unsigned a, unsigned b)
     const unsigned springs = DEM_FEAT_TANGENTIAL | DEM_FEAT_ROLLING;
     return (a & springs) == (b & springs);
 }
+
+/// Stiffnesses of a contact at overlap h with effective radius R*, as its
+/// linearisation reads them: the normal tangent stiffness dF_n/dh, the
+/// tangential and the rolling spring (sticking), and the dashpot γ_n.
+typedef struct dem_contact_stiffness {
+    double k_n, k_t, k_r, gamma;
+} dem_contact_stiffness;
+
+/// The descriptor of a contact law: its sub-models by name, the kernel's
+/// mask bit for it, and what the code outside the kernel needs of it — the
+/// check, the coefficients, the linearisation (stability limit), the
+/// elastic energy (diagnostics) and the coarse-graining rule (dem_scaling.c).
+/// One row per dem_contact_law (dem_contact.c); the force loops read only
+/// the mask bit.
+typedef struct dem_contact_model {
+    const char *name;                                  ///< "linear", "hertz_mindlin"
+    const char *normal, *damping, *tangential, *rolling; ///< sub-models, for reports
+    unsigned feature;                                  ///< kernel bit: 0 or DEM_FEAT_HERTZ
+    /// Check the law's own fields; message naming the field, non-zero on error.
+    int (*check)(const dem_contact_params *p, char *msg, unsigned long msg_len);
+    /// Its coefficients into c (the law-independent ones are set already).
+    void (*coeffs)(const dem_contact_params *p, dem_contact_coeffs *c);
+    /// Whether the parameters switch the tangential spring on (with μ_s > 0).
+    int (*has_tangential)(const dem_contact_params *p);
+    /// Stiffnesses at overlap h, R*, m* (see dem_contact_stiffness).
+    dem_contact_stiffness (*stiffness_at)(const dem_contact_params *p, double h, double rstar, double mstar);
+    /// Elastic energy of the normal spring at overlap h, R*.
+    double (*normal_energy)(const dem_contact_params *p, double h, double rstar);
+    /// Coarse-grained parameters for λ = N_real/N_scaled (eq. 15–18's
+    /// principle: the relative overlap h/R under the same force is kept).
+    dem_contact_params (*scale)(const dem_contact_params *p, double length_ratio);
+} dem_contact_model;
+
+/// The descriptor of a law; that of DEM_LAW_LINEAR for an unknown value
+/// (dem_contact_params_check rejects one).
+const dem_contact_model *dem_contact_model_of(dem_contact_law law);
+
+/// Name of a contact law ("linear", "hertz_mindlin") and its inverse; -1 for
+/// an unknown name.
+const char *dem_contact_law_name(dem_contact_law law);
+int dem_contact_law_from_name(const char *name);
 
 /// Derive kernel coefficients from parameters.
 dem_contact_coeffs dem_contact_coeffs_make(const dem_contact_params *p);
@@ -191,7 +271,26 @@ typedef struct dem_contact_drive {
     double fn_abs; ///< |F_n|, to which the Coulomb limits are proportional
     dem_vec3 vt;   ///< tangential part of the contact-point velocity (eq. 7)
     dem_vec3 vr;   ///< rolling velocity −R* (ω_i − ω_j) × n (eq. 12)
+    /// Hertz–Mindlin: the tangential stiffness at this overlap and its
+    /// inverse (0 where it is 0); the linear law uses k_s of the coefficients.
+    double k_t, inv_k_t;
 } dem_contact_drive;
+
+/// The Hertz–Mindlin normal stage, with a = sqrt(R* h) the contact radius:
+/// F_n = (4/3) E* a h (Hertz 1882; Johnson 1985, sec. 4.2), the dashpot
+/// γ_n = 2 sqrt(5/6) ξ sqrt(S_n m*) with S_n = 2 E* a (Tsuji et al. 1992, in
+/// the form of LIGGGHTS and Antypov & Elliott 2011), and Mindlin's (1949)
+/// no-slip tangential stiffness k_t = 8 G* a. Returns the elastic force;
+/// *gamma_unit is γ_n for a dashpot that is on.
+static DEM_ALWAYS_INLINE double dem_hertz_normal(const dem_contact_coeffs *c, const dem_contact_state *s,
+                                                 double *gamma_unit, dem_contact_drive *drive)
+{
+    const double a = sqrt(s->reduced_radius * s->overlap);
+    *gamma_unit = c->hertz_damp * sqrt(a) * s->root_reduced_mass;
+    drive->k_t = c->hertz_kt * a;
+    drive->inv_k_t = drive->k_t > DBL_MIN ? 1.0 / drive->k_t : 0.0; // a select: the batch stays vectorised
+    return c->hertz_kn * a * s->overlap;
+}
 
 /// First stage of the law: the normal force of eq. 3–4 into out->force,
 /// out->normal_force and out->damping_coeff; the springs' drive.
@@ -201,13 +300,16 @@ static DEM_ALWAYS_INLINE dem_contact_drive dem_contact_normal(const dem_contact_
 {
     const dem_vec3 n = s->normal;
     const double vn = dem_v3_dot(s->vrel, n); // > 0 approaching (eq. 5)
+    dem_contact_drive drive = {0.0, dem_v3(0, 0, 0), dem_v3(0, 0, 0), 0.0, 0.0};
     // Eq. 3: F_n = −k_n h n − γ_n v_rel,n; here fn is its magnitude along −n.
-    double fn = c->k_n * s->overlap;
+    // Hertz–Mindlin: the same with its own spring and dashpot.
+    double hertz_gamma = 0.0;
+    double fn = (features & DEM_FEAT_HERTZ) ? dem_hertz_normal(c, s, &hertz_gamma, &drive) : c->k_n * s->overlap;
     out->damping_coeff = 0.0;
     if (features & DEM_FEAT_DAMPING) {
         // Eq. 4: γ_n = 2ξ sqrt(m* k_n), on for the phase(s) the reading selects.
         double on = vn > 0.0 ? c->damp_approaching : c->damp_separating;
-        double gamma = on * c->two_xi_sqrt_kn * s->root_reduced_mass;
+        double gamma = (features & DEM_FEAT_HERTZ) ? on * hertz_gamma : on * c->two_xi_sqrt_kn * s->root_reduced_mass;
         fn += gamma * vn;
         int clamped = c->clamp_tension != 0.0 && fn < 0.0;
         fn = clamped ? 0.0 : fn;
@@ -215,7 +317,7 @@ static DEM_ALWAYS_INLINE dem_contact_drive dem_contact_normal(const dem_contact_
     }
     out->normal_force = fn;
     out->force = dem_v3_scale(n, -fn);
-    dem_contact_drive drive = {fabs(fn), dem_v3(0, 0, 0), dem_v3(0, 0, 0)};
+    drive.fn_abs = fabs(fn);
     // Eq. 7: tangential part of the contact-point relative velocity.
     if (features & DEM_FEAT_TANGENTIAL) drive.vt = dem_v3_axpy(-vn, n, s->vrel);
     // Eq. 12: v_rel,r = −R* (ω_i − ω_j) × n.
@@ -226,7 +328,17 @@ static DEM_ALWAYS_INLINE dem_contact_drive dem_contact_normal(const dem_contact_
 /// Slot in the history of the rolling spring: after the tangential one.
 static inline int dem_rolling_slot(unsigned features) { return (features & DEM_FEAT_TANGENTIAL) ? 3 : 0; }
 
-/// The LSD contact law, eq. 3–8 and 11–13. `features` must be a constant at
+/// The tangential spring's stiffness and its inverse: k_s (eq. 6), or
+/// Mindlin's at this overlap (dem_hertz_normal).
+static DEM_ALWAYS_INLINE double dem_tangential_k(const dem_contact_coeffs *c, const dem_contact_drive *d,
+                                                 double *inv_k, const unsigned features)
+{
+    *inv_k = (features & DEM_FEAT_HERTZ) ? d->inv_k_t : c->inv_k_s;
+    return (features & DEM_FEAT_HERTZ) ? d->k_t : c->k_s;
+}
+
+/// The contact law, eq. 3–8 and 11–13 (or Hertz–Mindlin's normal and
+/// tangential stages). `features` must be a constant at
 /// the call site. `hist` holds dem_history_len(features) doubles: tangential
 /// spring δ_s first (if on), then rolling spring δ_r (if on); zero for a new
 /// contact. Springs store displacements; forces are −k·δ.
@@ -239,9 +351,11 @@ static DEM_ALWAYS_INLINE void dem_contact_eval(const dem_contact_coeffs *c, cons
     out->f_tangential = out->f_rolling = dem_v3(0, 0, 0);
     if (features & DEM_FEAT_TANGENTIAL) {
         dem_vec3 f;
-        const dem_vec3 spring = dem_spring_advance(hist, s->normal, s->twist, drive.vt, s->dt, c->k_s, &f);
-        out->f_tangential = dem_spring_limit(hist, spring, f, c->inv_k_s, c->mu_s * drive.fn_abs, &stick);
-        out->k_tangential = stick ? c->k_s : 0.0;
+        double inv_k;
+        const double k = dem_tangential_k(c, &drive, &inv_k, features);
+        const dem_vec3 spring = dem_spring_advance(hist, s->normal, s->twist, drive.vt, s->dt, k, &f);
+        out->f_tangential = dem_spring_limit(hist, spring, f, inv_k, c->mu_s * drive.fn_abs, &stick);
+        out->k_tangential = stick ? k : 0.0;
         out->force = dem_v3_add(out->force, out->f_tangential);
     }
     if (features & DEM_FEAT_ROLLING) {

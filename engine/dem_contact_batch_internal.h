@@ -35,6 +35,7 @@ typedef struct contact_batch {
     double n[3][DEM_BATCH], overlap[DEM_BATCH], vrel[3][DEM_BATCH], wrel[3][DEM_BATCH], twist[DEM_BATCH];
     double lever[2][DEM_BATCH];
     double fn_abs[DEM_BATCH], vt[3][DEM_BATCH], vr[3][DEM_BATCH];
+    double k_t[DEM_BATCH], inv_k_t[DEM_BATCH]; // Hertz–Mindlin: the tangential spring at this overlap
     double spring[6][DEM_BATCH], spring_force[6][DEM_BATCH];
 } contact_batch;
 
@@ -122,36 +123,41 @@ static DEM_ALWAYS_INLINE void batch_normal(const dem_contact_coeffs *restrict cc
         b->fn_abs[e] = drive.fn_abs;
         batch_store_v3(b->vt, e, drive.vt);
         batch_store_v3(b->vr, e, drive.vr);
+        if (mask & DEM_FEAT_HERTZ) b->k_t[e] = drive.k_t, b->inv_k_t[e] = drive.inv_k_t;
     }
 }
 
 // Stage 3: one spring carried and advanced (dem_spring_advance). `hist_row`:
 // its first row in hist (0 tangential, dem_rolling_slot rolling); `row`: its
-// first row in spring and spring_force (0 tangential, 3 rolling).
+// first row in spring and spring_force (0 tangential, 3 rolling). The
+// stiffness k, or each lane's own in b->k_t where `per_lane` (a constant:
+// Mindlin's spring stiffens with the overlap).
 static DEM_ALWAYS_INLINE void batch_advance(contact_batch *restrict b, int hist_row, int row,
-                                            double (*vel)[DEM_BATCH], double k, double dt)
+                                            double (*vel)[DEM_BATCH], double k, double dt, const int per_lane)
 {
     DEM_INDEPENDENT_ITERATIONS
     for (int e = 0; e < b->count; ++e) {
         const double h[3] = {b->hist[hist_row][e], b->hist[hist_row + 1][e], b->hist[hist_row + 2][e]};
         dem_vec3 f;
-        const dem_vec3 spring =
-            dem_spring_advance(h, BATCH_V3(b->n, e), b->twist[e], BATCH_V3(vel, e), dt, k, &f);
+        const dem_vec3 spring = dem_spring_advance(h, BATCH_V3(b->n, e), b->twist[e], BATCH_V3(vel, e), dt,
+                                                   per_lane ? b->k_t[e] : k, &f);
         batch_store_v3(b->spring + row, e, spring);
         batch_store_v3(b->spring_force + row, e, f);
     }
 }
 
 // Stage 4: one spring's Coulomb limit (dem_spring_limit): its force in place
-// in spring_force, the spring into hist.
-static DEM_ALWAYS_INLINE void batch_limit(contact_batch *restrict b, int hist_row, int row, double inv_k, double mu)
+// in spring_force, the spring into hist. 1/k, or each lane's own in
+// b->inv_k_t where `per_lane`, as batch_advance.
+static DEM_ALWAYS_INLINE void batch_limit(contact_batch *restrict b, int hist_row, int row, double inv_k, double mu,
+                                          const int per_lane)
 {
     DEM_INDEPENDENT_ITERATIONS
     for (int e = 0; e < b->count; ++e) {
         double h[3];
         int stick;
         const dem_vec3 f = dem_spring_limit(h, BATCH_V3(b->spring + row, e), BATCH_V3(b->spring_force + row, e),
-                                            inv_k, mu * b->fn_abs[e], &stick);
+                                            per_lane ? b->inv_k_t[e] : inv_k, mu * b->fn_abs[e], &stick);
         batch_store_v3(b->spring_force + row, e, f);
         for (int q = 0; q < 3; ++q) b->hist[hist_row + q][e] = h[q];
     }
@@ -161,12 +167,12 @@ static DEM_ALWAYS_INLINE void batch_limit(contact_batch *restrict b, int hist_ro
 static DEM_ALWAYS_INLINE void batch_law(const dem_contact_coeffs *restrict cc, contact_batch *restrict b, double dt,
                                         const unsigned mask)
 {
-    const int rolling = dem_rolling_slot(mask);
+    const int rolling = dem_rolling_slot(mask), mindlin = (mask & DEM_FEAT_HERTZ) != 0;
     batch_normal(cc, b, dt, mask);
-    if (mask & DEM_FEAT_TANGENTIAL) batch_advance(b, 0, 0, b->vt, cc->k_s, dt);
-    if (mask & DEM_FEAT_ROLLING) batch_advance(b, rolling, 3, b->vr, cc->k_r, dt);
-    if (mask & DEM_FEAT_TANGENTIAL) batch_limit(b, 0, 0, cc->inv_k_s, cc->mu_s);
-    if (mask & DEM_FEAT_ROLLING) batch_limit(b, rolling, 3, cc->inv_k_r, cc->mu_r);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_advance(b, 0, 0, b->vt, cc->k_s, dt, mindlin);
+    if (mask & DEM_FEAT_ROLLING) batch_advance(b, rolling, 3, b->vr, cc->k_r, dt, 0);
+    if (mask & DEM_FEAT_TANGENTIAL) batch_limit(b, 0, 0, cc->inv_k_s, cc->mu_s, mindlin);
+    if (mask & DEM_FEAT_ROLLING) batch_limit(b, rolling, 3, cc->inv_k_r, cc->mu_r, 0);
 }
 
 // A lane's tangential and rolling forces (zero for a spring that is off),
@@ -244,9 +250,17 @@ static DEM_ALWAYS_INLINE void wall_batch_compute(const dem_contact_coeffs *restr
     {                                                                                                    \
         wall_batch_compute(cc, dt, b, M);                                                                \
     }
-// The functions f0 … f15 instantiated for each feature mask, as a table.
-#define DEM_BY_MASK_8(f) {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7}
+// The functions f0 … f31 instantiated for each feature mask, as a table.
 #define DEM_BY_MASK_16(f) \
     {f##0, f##1, f##2, f##3, f##4, f##5, f##6, f##7, f##8, f##9, f##10, f##11, f##12, f##13, f##14, f##15}
+#define DEM_BY_MASK_32(f)                                                                                           \
+    {f##0,  f##1,  f##2,  f##3,  f##4,  f##5,  f##6,  f##7,  f##8,  f##9,  f##10, f##11, f##12, f##13, f##14, f##15, \
+     f##16, f##17, f##18, f##19, f##20, f##21, f##22, f##23, f##24, f##25, f##26, f##27, f##28, f##29, f##30, f##31}
+// Instantiate M(0) … M(15), or M(0) … M(31): one per kernel mask, or per mask.
+#define DEM_FOR_MASKS_16(M) \
+    M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7) M(8) M(9) M(10) M(11) M(12) M(13) M(14) M(15)
+#define DEM_FOR_MASKS_32(M)                                                                                        \
+    DEM_FOR_MASKS_16(M)                                                                                            \
+    M(16) M(17) M(18) M(19) M(20) M(21) M(22) M(23) M(24) M(25) M(26) M(27) M(28) M(29) M(30) M(31)
 
 #endif

@@ -4,17 +4,23 @@
 // interval, never inside the step loop.
 #include "dem_state_internal.h"
 
-static double spring_energy(const double *hist, unsigned features, const dem_contact_params *p)
+// Elastic energy of a contact at overlap h with effective radius R*: its
+// normal spring (the law's, dem_contact_model.normal_energy) and its
+// tangential and rolling springs at their stiffness at this overlap.
+static double contact_energy(const double *hist, unsigned features, const dem_contact_params *p, double h,
+                             double rstar)
 {
+    const dem_contact_model *law = dem_contact_model_of(p->law);
+    const double k_t = law->stiffness_at(p, h, rstar, 0.0).k_t;
     double e = 0;
     int slot = 0;
     if (features & DEM_FEAT_TANGENTIAL) {
-        e += 0.5 * p->k_s * (hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2]);
+        e += 0.5 * k_t * (hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2]);
         slot = 3;
     }
     if (features & DEM_FEAT_ROLLING)
         e += 0.5 * p->k_r * (hist[slot] * hist[slot] + hist[slot + 1] * hist[slot + 1] + hist[slot + 2] * hist[slot + 2]);
-    return e;
+    return law->normal_energy(p, h, rstar) + e;
 }
 
 // Overlap of neighbour-list pair k of granule i (> 0: in contact).
@@ -45,7 +51,8 @@ static void pair_diagnostics(const dem_world *w, dem_diagnostics *d)
             d->contacts++;
             double rmin = w->rad[i] < w->rad[j] ? w->rad[i] : w->rad[j];
             if (h / rmin > d->max_overlap_ratio) d->max_overlap_ratio = h / rmin;
-            d->potential_elastic += 0.5 * p->k_n * h * h + spring_energy(w->nl.hist + k * hl, w->features, p);
+            const double rstar = w->rad[i] * w->rad[j] / (w->rad[i] + w->rad[j]);
+            d->potential_elastic += contact_energy(w->nl.hist + k * hl, w->features, p, h, rstar);
         }
 }
 
@@ -58,8 +65,8 @@ static void wall_diagnostics(const dem_world *w, dem_diagnostics *d)
             if (!(h > 0)) continue;
             d->wall_contacts++;
             if (h / w->rad[i] > d->max_overlap_ratio) d->max_overlap_ratio = h / w->rad[i];
-            d->potential_elastic += 0.5 * wl->def.contact.k_n * h * h +
-                                    spring_energy(wl->hist + i * (size_t)wl->hist_len, wl->features, &wl->def.contact);
+            d->potential_elastic +=
+                contact_energy(wl->hist + i * (size_t)wl->hist_len, wl->features, &wl->def.contact, h, w->rad[i]);
         }
     }
 }

@@ -140,31 +140,17 @@ static DEM_ALWAYS_INLINE void pair_force(dem_world *restrict w, const pair_ctx *
     }
 }
 
-// The batch kernels, one per feature mask (see DEM_BATCH_KERNEL).
-DEM_BATCH_KERNEL(0)
-DEM_BATCH_KERNEL(1)
-DEM_BATCH_KERNEL(2)
-DEM_BATCH_KERNEL(3)
-DEM_BATCH_KERNEL(4)
-DEM_BATCH_KERNEL(5)
-DEM_BATCH_KERNEL(6)
-DEM_BATCH_KERNEL(7)
-DEM_BATCH_KERNEL(8)
-DEM_BATCH_KERNEL(9)
-DEM_BATCH_KERNEL(10)
-DEM_BATCH_KERNEL(11)
-DEM_BATCH_KERNEL(12)
-DEM_BATCH_KERNEL(13)
-DEM_BATCH_KERNEL(14)
-DEM_BATCH_KERNEL(15)
+// The batch kernels, one per kernel mask (see DEM_BATCH_KERNEL): the
+// periodic bit is the loop's, not the law's.
+DEM_FOR_MASKS_16(DEM_BATCH_KERNEL)
 typedef void (*batch_kernel_fn)(const pair_ctx *restrict, contact_batch *restrict);
-static const batch_kernel_fn batch_kernels[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(batch_compute_);
+static const batch_kernel_fn batch_kernels[DEM_FEAT_KERNEL_MASKS] = DEM_BY_MASK_16(batch_compute_);
 
 // Run the batch and add its results in the pairs' order; empties it.
 static DEM_ALWAYS_INLINE void batch_flush(const pair_ctx *restrict c, contact_batch *restrict b, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
-    batch_kernels[mask & (DEM_FEAT_COUNT_MASKS - 1)](c, b);
+    batch_kernels[mask & (DEM_FEAT_KERNEL_MASKS - 1)](c, b);
     for (int e = 0; e < b->count; ++e) {
         if (b->slot[e]) {
             add_slot(c, b->i[e], b->k[e]);
@@ -183,7 +169,7 @@ static DEM_ALWAYS_INLINE void batch_flush_to_slots(const pair_ctx *restrict c, c
                                                    const unsigned mask)
 {
     const int hl = dem_history_len(mask);
-    batch_kernels[mask & (DEM_FEAT_COUNT_MASKS - 1)](c, b);
+    batch_kernels[mask & (DEM_FEAT_KERNEL_MASKS - 1)](c, b);
     for (int e = 0; e < b->count; ++e) {
         const size_t k = b->k[e];
         batch_hist_out(b, e, c->hist + k * (size_t)hl, hl);
@@ -450,40 +436,18 @@ static DEM_ALWAYS_INLINE void pair_loop(dem_world *restrict w, const unsigned ma
         listed_crossing_pairs(w, rows, count, end, M);                                                  \
     }                                                                                                   \
     static void own_pairs_##M(dem_world *w, size_t lo, size_t hi) { block_own_pairs(w, lo, hi, M); }
-DEM_PAIR_LOOP(0)
-DEM_PAIR_LOOP(1)
-DEM_PAIR_LOOP(2)
-DEM_PAIR_LOOP(3)
-DEM_PAIR_LOOP(4)
-DEM_PAIR_LOOP(5)
-DEM_PAIR_LOOP(6)
-DEM_PAIR_LOOP(7)
-DEM_PAIR_LOOP(8)
-DEM_PAIR_LOOP(9)
-DEM_PAIR_LOOP(10)
-DEM_PAIR_LOOP(11)
-DEM_PAIR_LOOP(12)
-DEM_PAIR_LOOP(13)
-DEM_PAIR_LOOP(14)
-DEM_PAIR_LOOP(15)
+DEM_FOR_MASKS_32(DEM_PAIR_LOOP)
 #define DEM_GENERAL_IMAGE_LOOP(M) \
     static void general_image_pair_loop_##M(dem_world *w) { pair_loop(w, DEM_FEAT_PERIODIC | DEM_GENERAL_IMAGE | M); }
-DEM_GENERAL_IMAGE_LOOP(0)
-DEM_GENERAL_IMAGE_LOOP(1)
-DEM_GENERAL_IMAGE_LOOP(2)
-DEM_GENERAL_IMAGE_LOOP(3)
-DEM_GENERAL_IMAGE_LOOP(4)
-DEM_GENERAL_IMAGE_LOOP(5)
-DEM_GENERAL_IMAGE_LOOP(6)
-DEM_GENERAL_IMAGE_LOOP(7)
+DEM_FOR_MASKS_16(DEM_GENERAL_IMAGE_LOOP)
 
 typedef void (*pair_loop_fn)(dem_world *);
 typedef void (*crossing_pairs_fn)(dem_world *, const uint32_t *, size_t, size_t);
 typedef void (*block_pairs_fn)(dem_world *, size_t, size_t);
-static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(pair_loop_);
-static const crossing_pairs_fn crossing_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(crossing_pairs_);
-static const block_pairs_fn own_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_16(own_pairs_);
-static const pair_loop_fn general_image_pair_loops[8] = DEM_BY_MASK_8(general_image_pair_loop_);
+static const pair_loop_fn pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_32(pair_loop_);
+static const crossing_pairs_fn crossing_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_32(crossing_pairs_);
+static const block_pairs_fn own_pair_loops[DEM_FEAT_COUNT_MASKS] = DEM_BY_MASK_32(own_pairs_);
+static const pair_loop_fn general_image_pair_loops[DEM_FEAT_KERNEL_MASKS] = DEM_BY_MASK_16(general_image_pair_loop_);
 
 // Each granule's own dashpots, Σγ n nᵀ over its contacts (implicit dashpot).
 static void gather_damping(dem_world *restrict w)

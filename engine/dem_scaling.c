@@ -48,15 +48,9 @@ double dem_scale_stiffness(double k, double lambda)
 
 dem_contact_params dem_scale_contact(const dem_contact_params *p, double lambda)
 {
-    dem_contact_params s = *p;
-    // The paper takes k_n = k_s = k_r (section 3.2); all three are springs
-    // on a length (overlap, tangential and rolling displacement, N/m), so
-    // eq. 18 keeps each displacement in proportion to R.
-    s.k_n = dem_scale_stiffness(p->k_n, lambda);
-    s.k_s = dem_scale_stiffness(p->k_s, lambda);
-    s.k_r = dem_scale_stiffness(p->k_r, lambda);
-    // μ_s, μ_r and ξ are dimensionless ratios: unchanged.
-    return s;
+    // Each law's own rule (dem_contact_model.scale): the linear law's is eq.
+    // 18 on k_n, k_s, k_r; Hertz–Mindlin's keeps eq. 18's relative overlap.
+    return dem_contact_model_of(p->law)->scale(p, length_ratio(lambda));
 }
 
 dem_gsd dem_scale_gsd(const dem_gsd *g, double lambda)

@@ -34,8 +34,12 @@ double dem_scale_density(double rho, double lambda);
 /// Applies to k_n, k_s and k_r alike.
 double dem_scale_stiffness(double k, double lambda);
 
-/// Contact parameters of the coarse system: k_n, k_s, k_r scaled by eq. 18;
-/// friction coefficients, damping ratio ξ and damping reading unchanged.
+/// Contact parameters of the coarse system, by the law's own rule: the
+/// linear law's k_n, k_s, k_r scaled by eq. 18; Hertz–Mindlin's E* and G* by
+/// (R^r/R^s)² = λ^(−2/3), which keeps eq. 18's relative overlap h/R under a
+/// given force for a Hertz spring (derivation in dem_contact.c, hertz_scale),
+/// and its k_r by eq. 18. Friction coefficients, damping ratio ξ, damping
+/// reading and law unchanged.
 dem_contact_params dem_scale_contact(const dem_contact_params *p, double lambda);
 
 /// GSD of the coarse system: every diameter × λ^(1/3) (eq. 15), so the

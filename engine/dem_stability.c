@@ -44,13 +44,17 @@ static void apply(const dem_contact_network *net, const dof6 *x, dof6 *y, enum o
         dem_vec3 tj = wall ? dem_v3(0, 0, 0) : dem_v3_scale(x[j].t, rj);
         dem_vec3 du = dem_v3_sub(ui, uj), n = g->n;
         dem_vec3 f, torque_i = dem_v3(0, 0, 0), torque_j = dem_v3(0, 0, 0);
+        // The law's tangent stiffnesses at this contact's overlap (the
+        // linear law's are its constants k_n, k_s, k_r and eq. 4's dashpot).
+        const dem_contact_stiffness ks =
+            dem_contact_model_of(g->p->law)->stiffness_at(g->p, g->overlap, g->rstar, g->mstar);
         if (dashpot) {
-            f = dem_v3_scale(n, 2 * g->p->xi * sqrt(g->mstar * g->p->k_n) * dem_v3_dot(du, n));
+            f = dem_v3_scale(n, ks.gamma * dem_v3_dot(du, n));
         } else if (op == OP_NORMAL) {
-            f = dem_v3_scale(n, g->p->k_n * dem_v3_dot(du, n));
+            f = dem_v3_scale(n, ks.k_n * dem_v3_dot(du, n));
         } else { // every spring sticking, at its own stiffness
-            const dem_linear_contact l = {.n = n, .ai = g->ai, .aj = g->aj, .rs = g->rstar, .kn = g->p->k_n,
-                                          .kt = g->p->k_s, .kr = g->p->k_r, .c = 1.0};
+            const dem_linear_contact l = {.n = n, .ai = g->ai, .aj = g->aj, .rs = g->rstar, .kn = ks.k_n,
+                                          .kt = ks.k_t, .kr = ks.k_r, .c = 1.0};
             const dem_linear_response r = dem_linear_contact_apply(&l, du, ti, tj);
             f = r.f, torque_i = r.torque_i, torque_j = r.torque_j;
         }
@@ -184,7 +188,7 @@ static size_t fcc_contacts(const fcc_cluster *c, double radius, double lever_fac
             if (!(h > 0) || dist <= 0) continue;
             out[m++] = (dem_network_contact){i, j, dem_v3_scale(d, 1 / dist), radius - 0.5 * lever_factor * h,
                                              radius - 0.5 * lever_factor * h, radius * radius / (radius + radius),
-                                             1 / (c->inv_mass[i] + c->inv_mass[j]), p};
+                                             1 / (c->inv_mass[i] + c->inv_mass[j]), p, h};
         }
     return m;
 }
@@ -209,5 +213,38 @@ dem_stability dem_stability_fcc(const dem_contact_params *p, double lever_factor
     snprintf(inner, sizeof inner, "%.99s", st.why);
     snprintf(st.why, sizeof st.why, "densest cluster of the lightest granules (FCC, 12 sticking contacts; %.99s)",
              inner);
+    return st;
+}
+
+// Poisson's ratio and shear modulus of the granules' material from the
+// effective moduli of two equal granules: E* = E/(2(1−ν²)) and G* =
+// G/(2(2−ν)) with G = E/(2(1+ν)) give G*/E* = (1−ν)/(2(2−ν)), so ν = (1 −
+// 4r)/(1 − 2r) for r = G*/E*, kept within [0, 0.5]. Without G* (no
+// tangential spring), ν = 0: the stiffest shear modulus, G = E*, the
+// shortest Rayleigh time.
+static void material_of(const dem_contact_params *p, double *nu, double *shear)
+{
+    const double r = p->shear_modulus / p->youngs_modulus;
+    double v = p->shear_modulus > 0 ? (1 - 4 * r) / (1 - 2 * r) : 0.0;
+    v = v < 0 ? 0 : v > 0.5 ? 0.5 : v;
+    *nu = v;
+    *shear = p->shear_modulus > 0 ? 2 * (2 - v) * p->shear_modulus : (1 - v) * p->youngs_modulus;
+}
+
+double dem_rayleigh_time(const dem_contact_params *p, double m_min, double r_min)
+{
+    double nu, shear;
+    material_of(p, &nu, &shear);
+    const double density = m_min / (4.0 / 3.0 * DEM_PI * r_min * r_min * r_min);
+    return DEM_PI * r_min * sqrt(density / shear) / (0.1631 * nu + 0.8766);
+}
+
+dem_stability dem_stability_rayleigh(const dem_contact_params *p, double m_min, double r_min)
+{
+    dem_stability st = {0};
+    st.dt_crit = dem_rayleigh_time(p, m_min, r_min);
+    st.dt_limit = DEM_RAYLEIGH_FRACTION * st.dt_crit;
+    snprintf(st.why, sizeof st.why, "Hertz-Mindlin: %.2g of the Rayleigh time %.4g s of the smallest granules",
+             DEM_RAYLEIGH_FRACTION, st.dt_crit);
     return st;
 }

@@ -31,12 +31,15 @@ typedef struct dem_stability {
 /// One contact of a network, linearised about its current geometry: granule
 /// i against granule j, or against a wall (j = SIZE_MAX: a partner of
 /// infinite mass); unit normal n from i towards the partner, lever arms ai
-/// and aj, R*, m*, and the contact's parameters (k_n, k_s, k_r, ξ).
+/// and aj, R*, m*, the contact's parameters (k_n, k_s, k_r, ξ) and its
+/// overlap h, at which a law whose springs stiffen with the overlap
+/// (Hertz–Mindlin) is linearised (dem_contact_model.stiffness_at).
 typedef struct dem_network_contact {
     size_t i, j;
     dem_vec3 n;
     double ai, aj, rstar, mstar;
     const dem_contact_params *p;
+    double overlap;
 } dem_network_contact;
 
 /// A contact network: the granules' masses and moments of inertia, and the
@@ -65,6 +68,24 @@ dem_stability dem_stability_of_network(const dem_contact_network *net, const dem
 /// the contact-point lever arm, 0 for R.
 dem_stability dem_stability_fcc(const dem_contact_params *p, double lever_factor, const dem_integration *how,
                                 double m_min, double r_min, double dt_crit);
+
+/// The Rayleigh time of the smallest granules, the reference step of a
+/// Hertz–Mindlin contact (its eq. 14): t_R = π R √(ρ/G) / (0.1631 ν +
+/// 0.8766), the time a Rayleigh surface wave takes across a granule
+/// (Li, Xu & Thornton 2005, Powder Technol. 160:219; Thornton 2015,
+/// "Granular Dynamics, Contact Mechanics and Particle System Simulations",
+/// sec. 2.6), with ρ from m_min and r_min and ν and G from E* and G* read as
+/// two granules of one material (see material_of in dem_stability.c).
+double dem_rayleigh_time(const dem_contact_params *p, double m_min, double r_min);
+
+/// A Hertz–Mindlin contact's stiffness grows with the overlap, so no
+/// a-priori cluster has one frequency: the limit before a run is instead a
+/// fraction of the Rayleigh time, the DEM literature's rule for Hertzian
+/// contacts (0.2–0.4 t_R is the usual range; Li et al. 2005). The limit of a
+/// current network (dem_stability_current) is the power iteration at each
+/// contact's own overlap.
+#define DEM_RAYLEIGH_FRACTION 0.2
+dem_stability dem_stability_rayleigh(const dem_contact_params *p, double m_min, double r_min);
 
 /// Limit for the scene before it runs: dem_stability_fcc of the scene's
 /// lightest granules, with the stiffest of the granule and wall springs.

@@ -30,24 +30,40 @@ static int check_periodic_length(dem_world *w)
     return 0;
 }
 
+// How the reports name the reference step dt_crit: eq. 14 for the linear
+// law, the Rayleigh time for Hertz–Mindlin (dem_rayleigh_time).
+typedef struct reference_step_text {
+    const char *source, *formula, *note;
+} reference_step_text;
+
+static reference_step_text reference_step_of(const dem_world *w)
+{
+    if (w->def.granule.law == DEM_LAW_HERTZ_MINDLIN)
+        return (reference_step_text){"Rayleigh time", "pi R sqrt(rho/G)/(0.1631 nu + 0.8766)",
+                                     "Hertz-Mindlin's limit before a run is 0.2 of it"};
+    return (reference_step_text){"eq. 14", "sqrt(m_min/k_n)", "the paper uses 0.6"};
+}
+
 // Check a configured step against a stability limit, or choose the step as
 // dt_safety of it; record the limit and say how the step was found.
 static dem_status apply_limit(dem_world *w, const dem_stability *st, const char *source)
 {
+    const reference_step_text ref = reference_step_of(w);
     if (w->def.dt > 0 && w->def.dt > st->dt_limit && !w->def.allow_unstable_dt) {
         dem_world_set_error(w,
-                            "time step %g s (%.3f of dt_crit = sqrt(m_min/k_n) = %g s, eq. 14) is above the "
+                            "time step %g s (%.3f of dt_crit = %s = %g s, %s) is above the "
                             "%s stability limit %g s (%.3f of dt_crit): %s. Use a step <= %g s or leave dt unset.",
-                            w->def.dt, w->def.dt / st->dt_crit, st->dt_crit, source, st->dt_limit,
-                            st->dt_limit / st->dt_crit, st->why, st->dt_limit);
+                            w->def.dt, w->def.dt / st->dt_crit, ref.formula, st->dt_crit, ref.source, source,
+                            st->dt_limit, st->dt_limit / st->dt_crit, st->why, st->dt_limit);
         return DEM_ERR_UNSTABLE;
     }
     w->dt_limit = st->dt_limit;
     w->dt = w->def.dt > 0 ? w->def.dt : w->def.dt_safety * st->dt_limit;
     snprintf(w->dt_report, sizeof w->dt_report,
-             "dt = %.4g s = %.3f dt_crit (eq. 14: dt_crit = sqrt(m_min/k_n) = %.4g s; the paper uses 0.6); %s limit "
+             "dt = %.4g s = %.3f dt_crit (%s: dt_crit = %s = %.4g s; %s); %s limit "
              "from the %s: %.4g s = %.3f dt_crit%s",
-             w->dt, w->dt / st->dt_crit, st->dt_crit, source, st->why, st->dt_limit, st->dt_limit / st->dt_crit,
+             w->dt, w->dt / st->dt_crit, ref.source, ref.formula, st->dt_crit, ref.note, source, st->why,
+             st->dt_limit, st->dt_limit / st->dt_crit,
              w->def.dt > 0 ? " (step as configured)" : "; step chosen at dt_safety of it");
     return DEM_OK;
 }

@@ -13,16 +13,9 @@
 #include "dem_wall_contacts_internal.h"
 
 // The wall batch kernels, one per wall feature mask (see DEM_WALL_KERNEL).
-DEM_WALL_KERNEL(0)
-DEM_WALL_KERNEL(1)
-DEM_WALL_KERNEL(2)
-DEM_WALL_KERNEL(3)
-DEM_WALL_KERNEL(4)
-DEM_WALL_KERNEL(5)
-DEM_WALL_KERNEL(6)
-DEM_WALL_KERNEL(7)
+DEM_FOR_MASKS_16(DEM_WALL_KERNEL)
 typedef void (*wall_kernel_fn)(const dem_contact_coeffs *restrict, double, contact_batch *restrict);
-static const wall_kernel_fn wall_kernels[8] = DEM_BY_MASK_8(wall_batch_compute_);
+static const wall_kernel_fn wall_kernels[DEM_FEAT_KERNEL_MASKS] = DEM_BY_MASK_16(wall_batch_compute_);
 
 // Geometry and kinematics of granule i against a wall (the wall a granule
 // of infinite mass and radius: m* = m_i, R* = R_i), and its lever arm; 0 if
@@ -86,7 +79,7 @@ static DEM_ALWAYS_INLINE void wall_flush(dem_world *restrict w, const dem_wall *
                                          dem_vec3 *restrict kept, const unsigned mask)
 {
     const int hl = dem_history_len(mask);
-    wall_kernels[mask & 7u](&wall->coeffs, w->hist_dt, b);
+    wall_kernels[mask & (DEM_FEAT_KERNEL_MASKS - 1)](&wall->coeffs, w->hist_dt, b);
     for (int e = 0; e < b->count; ++e) {
         const size_t i = b->i[e];
         batch_hist_out(b, e, wall->hist + i * (size_t)hl, hl);
@@ -197,19 +190,12 @@ static DEM_ALWAYS_INLINE void wall_block(dem_world *restrict w, const dem_wall *
     {                                                                                                   \
         wall_block(w, wall, lo, hi, M);                                                                 \
     }
-DEM_WALL_LOOP(0)
-DEM_WALL_LOOP(1)
-DEM_WALL_LOOP(2)
-DEM_WALL_LOOP(3)
-DEM_WALL_LOOP(4)
-DEM_WALL_LOOP(5)
-DEM_WALL_LOOP(6)
-DEM_WALL_LOOP(7)
+DEM_FOR_MASKS_16(DEM_WALL_LOOP)
 
 typedef void (*wall_loop_fn)(dem_world *, const dem_wall *);
 typedef void (*wall_block_fn)(dem_world *, const dem_wall *, size_t, size_t);
-static const wall_loop_fn wall_loops[8] = DEM_BY_MASK_8(wall_loop_);
-static const wall_block_fn wall_blocks[8] = DEM_BY_MASK_8(wall_block_);
+static const wall_loop_fn wall_loops[DEM_FEAT_KERNEL_MASKS] = DEM_BY_MASK_16(wall_loop_);
+static const wall_block_fn wall_blocks[DEM_FEAT_KERNEL_MASKS] = DEM_BY_MASK_16(wall_block_);
 
 void dem_wall_contacts_begin(dem_world *w)
 {
@@ -219,10 +205,10 @@ void dem_wall_contacts_begin(dem_world *w)
 void dem_wall_contacts_compute(dem_world *w)
 {
     dem_wall_contacts_begin(w);
-    for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & 7u](w, &w->walls[k]);
+    for (int k = 0; k < w->n_walls; ++k) wall_loops[w->walls[k].features & (DEM_FEAT_KERNEL_MASKS - 1)](w, &w->walls[k]);
 }
 
 void dem_wall_contacts_block(dem_world *w, size_t lo, size_t hi)
 {
-    for (int k = 0; k < w->n_walls; ++k) wall_blocks[w->walls[k].features & 7u](w, &w->walls[k], lo, hi);
+    for (int k = 0; k < w->n_walls; ++k) wall_blocks[w->walls[k].features & (DEM_FEAT_KERNEL_MASKS - 1)](w, &w->walls[k], lo, hi);
 }

@@ -416,19 +416,27 @@ unsigned dem_world_features(const dem_world *w)
 const char *dem_world_error(const dem_world *w) { return w->err; }
 const char *dem_world_dt_report(const dem_world *w) { return w->dt_report; }
 
+// The law, named only where it is not the default, so that a linear scene's
+// description (and the result.json that carries it) stays as it was.
+static const char *law_note(const dem_contact_params *p)
+{
+    return p->law == DEM_LAW_HERTZ_MINDLIN ? ", law hertz_mindlin" : "";
+}
+
 void dem_world_describe_features(const dem_world *w, char *buf, size_t len)
 {
     unsigned f = w->features;
-    int used = snprintf(buf, len, "granule-granule: damping %s (%s), tangential %s, rolling %s; periodic axis %s",
+    int used = snprintf(buf, len, "granule-granule: damping %s (%s), tangential %s, rolling %s%s; periodic axis %s",
                         f & DEM_FEAT_DAMPING ? "on" : "off", dem_damping_mode_name(w->def.granule.damping),
                         f & DEM_FEAT_TANGENTIAL ? "on" : "off", f & DEM_FEAT_ROLLING ? "on" : "off",
+                        law_note(&w->def.granule),
                         f & DEM_FEAT_PERIODIC ? (const char *[]){"x", "y", "z"}[w->def.periodic_axis] : "off");
     for (int k = 0; k < w->n_walls && used > 0 && (size_t)used < len; ++k) {
         const dem_wall *wl = &w->walls[k];
-        used += snprintf(buf + used, len - used, "; wall %s (%s%s): damping %s, tangential %s, rolling %s",
+        used += snprintf(buf + used, len - used, "; wall %s (%s%s): damping %s, tangential %s, rolling %s%s",
                          wl->name, (const char *[]){"plane", "disc", "cylinder"}[wl->def.kind],
                          wl->def.spin != 0 || wl->translating ? ", moving" : "", wl->features & DEM_FEAT_DAMPING ? "on" : "off",
                          wl->features & DEM_FEAT_TANGENTIAL ? "on" : "off",
-                         wl->features & DEM_FEAT_ROLLING ? "on" : "off");
+                         wl->features & DEM_FEAT_ROLLING ? "on" : "off", law_note(&wl->def.contact));
     }
 }

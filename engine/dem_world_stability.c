@@ -35,7 +35,7 @@ static size_t collect_contacts(const dem_world *w, dem_network_contact **out)
             c[m++] = (dem_network_contact){i, j, dem_v3_scale(d, 1 / dist), w->rad[i] - 0.5 * w->lever_factor * h,
                                            w->rad[j] - 0.5 * w->lever_factor * h,
                                            w->rad[i] * w->rad[j] / (w->rad[i] + w->rad[j]),
-                                           1 / (w->inv_mass[i] + w->inv_mass[j]), &w->def.granule};
+                                           1 / (w->inv_mass[i] + w->inv_mass[j]), &w->def.granule, h};
         }
     for (int k = 0; k < w->n_walls; ++k)
         for (size_t i = 0; i < w->n; ++i) {
@@ -44,7 +44,7 @@ static size_t collect_contacts(const dem_world *w, dem_network_contact **out)
             dem_vec3 n = t.normal;
             if (!(h > 0)) continue;
             c[m++] = (dem_network_contact){i, SIZE_MAX, n, w->rad[i] - w->lever_factor * h, 0, w->rad[i], w->mass[i],
-                                           &w->walls[k].def.contact};
+                                           &w->walls[k].def.contact, h};
         }
     return m;
 }
@@ -54,10 +54,20 @@ static dem_integration integration_of(const dem_world *w)
     return (dem_integration){w->def.implicit_damping, w->implicit_springs, dashpot_switches(w)};
 }
 
+static int hertzian(const dem_world *w) { return w->def.granule.law == DEM_LAW_HERTZ_MINDLIN; }
+
+// The reference step of the granules' law: eq. 14's sqrt(m_min/k_n), or
+// the Rayleigh time of a Hertz–Mindlin law.
+static double reference_step(const dem_world *w)
+{
+    if (hertzian(w)) return dem_rayleigh_time(&w->def.granule, dem_granules_min_mass(w), dem_granules_min_radius(w));
+    return sqrt(dem_granules_min_mass(w) / w->def.granule.k_n);
+}
+
 dem_stability dem_stability_current(dem_world *w)
 {
     dem_stability st = {0};
-    st.dt_crit = w->n ? sqrt(dem_granules_min_mass(w) / w->def.granule.k_n) : 0;
+    st.dt_crit = w->n ? reference_step(w) : 0;
     if (!w->list_valid && w->n) {
         if (w->skin <= 0) w->skin = 0.4 * dem_granules_min_radius(w);
         if (dem_lists_rebuild(w)) return st;
@@ -92,6 +102,8 @@ dem_stability dem_stability_apriori(const dem_world *w)
     const dem_stability none = {0};
     if (!w->n) return none;
     double m_min = dem_granules_min_mass(w), r_min = dem_granules_min_radius(w);
+    // The granules' law decides; the walls' moduli do not enter a Rayleigh time.
+    if (hertzian(w)) return dem_stability_rayleigh(&w->def.granule, m_min, r_min);
     double dt_crit = sqrt(m_min / w->def.granule.k_n);
     dem_contact_params p = stiffest(w);
     // Sticking springs are the worst case: friction never truncates them here.

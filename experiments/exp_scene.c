@@ -122,7 +122,8 @@ int exp_field_error(const char *path, int n_sets, char *const *sets, const char 
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len)
 {
-    *out = (dem_contact_params){y->k_n, y->k_s, y->k_r, y->xi, y->mu_s, y->mu_r, EXP_DAMPING_DEFAULT};
+    *out = (dem_contact_params){.k_n = y->k_n, .k_s = y->k_s, .k_r = y->k_r, .xi = y->xi, .mu_s = y->mu_s,
+                                .mu_r = y->mu_r, .damping = EXP_DAMPING_DEFAULT};
     char field[96];
     snprintf(field, sizeof field, "%s.damping", where);
     if (exp_damping_from_name(y->damping, field, &out->damping, err, err_len)) return 1;

@@ -23,7 +23,7 @@ exp_silo_def exp_default_silo_def(void)
     d.gsd = dem_gsd_lognormal(1.0, 1.1, 2.0); // Table A.2: d50 = 1 m, σ_geo = 1.1
     d.density = 500;
     // Table A.2: k_n = k_s = 50 000 N/m, k_r = 0, ξ = 0, μ_s = 0.5, μ_r = 0.
-    d.granule = (dem_contact_params){50000, 50000, 0, 0, 0.5, 0, EXP_DAMPING_DEFAULT};
+    d.granule = (dem_contact_params){.k_n = 50000, .k_s = 50000, .mu_s = 0.5, .damping = EXP_DAMPING_DEFAULT};
     d.wall = d.granule;
     d.wall.k_n = d.wall.k_s = 100000;
     d.n_granules = 200;
@@ -368,8 +368,9 @@ static void to_def(const silo_yaml *y, exp_silo_def *d)
     d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
     d->density = y->density;
     // Table A.2: no rolling (k_r = μ_r = 0), one damping ratio for all contacts.
-    d->granule = (dem_contact_params){y->k_n, y->k_s, 0, y->xi, y->mu_s, 0, EXP_DAMPING_DEFAULT};
-    d->wall = (dem_contact_params){y->wall_k_n, y->wall_k_s, 0, y->xi, y->mu_s, 0, EXP_DAMPING_DEFAULT};
+    d->granule = (dem_contact_params){.k_n = y->k_n, .k_s = y->k_s, .xi = y->xi, .mu_s = y->mu_s, .damping = EXP_DAMPING_DEFAULT};
+    d->wall = (dem_contact_params){
+        .k_n = y->wall_k_n, .k_s = y->wall_k_s, .xi = y->xi, .mu_s = y->mu_s, .damping = EXP_DAMPING_DEFAULT};
     d->n_granules = y->n_granules > 0 ? (size_t)y->n_granules : 0;
     d->silo_radius = y->silo_radius, d->orifice_radius = y->orifice_radius, d->plate_z = y->plate_z;
     d->plate_sphere_radius = y->plate_sphere_radius;

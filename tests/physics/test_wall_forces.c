@@ -26,7 +26,8 @@ static const double G = 9.81, RHO = 1800.0, R = 1e-3;
 
 static dem_contact_params contact(double k, double xi, double mu_s, double mu_r)
 {
-    return (dem_contact_params){k, k, k, xi, mu_s, mu_r, DEM_DAMPING_ALWAYS};
+    return (dem_contact_params){
+        .k_n = k, .k_s = k, .k_r = k, .xi = xi, .mu_s = mu_s, .mu_r = mu_r, .damping = DEM_DAMPING_ALWAYS};
 }
 
 static dem_wall_def plane(dem_vec3 point, dem_vec3 normal, dem_contact_params c, const char *name)

@@ -33,7 +33,8 @@ static const double G = 9.81, RHO = 1800.0, R = 1e-3, K = 1000.0;
 
 static dem_contact_params contact(double xi, double mu_s)
 {
-    return (dem_contact_params){K, K, K, xi, mu_s, 0.0, DEM_DAMPING_ALWAYS}; // no rolling resistance
+    return (dem_contact_params){.k_n = K, .k_s = K, .k_r = K, .xi = xi, .mu_s = mu_s, .damping = DEM_DAMPING_ALWAYS};
+    // (μ_r = 0: no rolling resistance)
 }
 
 // One granule on the floor y = 0 (normal +y), settled at rest by the dashpot.
