@@ -16,6 +16,7 @@
 #include "dem_output.h"
 #include "exp_compress.h"
 #include "exp_cylinder_config.h"
+#include "exp_cylinder_runner.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
 #include "exp_silo.h"
@@ -225,7 +226,11 @@ static int run_compress(const char *path, const simulate_args *a)
 static int run_silo(const char *path, const simulate_args *a) { return exp_silo_simulate(path, a->n_sets, a->sets, a->out); }
 static int run_cylinder(const char *path, const simulate_args *a)
 {
-    return exp_cylinder_simulate(path, a->n_sets, a->sets, a->out);
+    char err[1400];
+    exp_cylinder_def d;
+    if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err))
+        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    return exp_cylinder_simulate(&d, a->out);
 }
 
 // Every experiment `granucal simulate` runs: the first whose `claims` knows
