@@ -11,6 +11,7 @@
 #include "dem_checkpoint.h"
 #include "exp_common.h"
 #include "exp_drum_config.h"
+#include "exp_drum_turn.h"
 #include "exp_image.h"
 #include "exp_result.h"
 
@@ -81,33 +82,26 @@ static int parse_rpm_list(const char *list, double *rpm, int cap, char *err, siz
 
 // Turn one copy of the settled bed at `rpm`; results in DIR (a sweep: in
 // DIR/rpm_<rpm>/).
-static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def *def, exp_drum_run_opts run, double rpm,
+static int turn_copy(dem_world *bed, exp_drum_yaml *y, const exp_drum_def *def, exp_drum_run_opts run, double rpm,
                      const char *dir, int sweep, progress_state *p, FILE *json_out, int first, double checkpoint_every_s)
 {
     char sub[1100], err[1024];
     if (sweep) snprintf(sub, sizeof sub, "%s/rpm_%g", dir, rpm);
     else snprintf(sub, sizeof sub, "%s", dir);
-    dem_world *w = dem_world_clone(bed);
-    if (!w || cal_mkdirs(sub, err, sizeof err)) {
-        fprintf(stderr, "granucal simulate: %s\n", w ? err : "out of memory copying the bed");
-        dem_world_destroy(w);
-        return 1;
-    }
+    if (cal_mkdirs(sub, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     run.rpm = y->rpm = rpm;
     // The run's checkpoint, labelled with what defines it (as a calibration's record).
     char key[2048], ck_path[1200];
     cal_drum_case whole = {.def = *def, .fill = *def, .run = run};
     cal_drum_key(&whole, rpm, key, sizeof key);
     snprintf(ck_path, sizeof ck_path, "%s/checkpoint.h5", sub);
-    exp_drum_checkpoint ck = {ck_path, key, checkpoint_every_s};
-    if (checkpoint_every_s > 0) run.checkpoint = &ck;
-    double t0 = exp_wall_seconds();
+    const exp_drum_turn turn = {.def = def, .run = run, .checkpoint_path = ck_path, .key = key,
+                                .checkpoint_every_s = checkpoint_every_s, .progress = show_progress,
+                                .progress_ctx = p, .progress_line_open = p->tty, .log_prefix = "granucal simulate:"};
     exp_drum_result r;
-    dem_status st = exp_drum_rotate(w, def, &run, show_progress, p, &r);
-    r.wall_time_s = exp_wall_seconds() - t0 + r.earlier_wall_s;
-    if (p->tty) fputc('\n', stderr);
-    if (r.checkpoint_note[0]) fprintf(stderr, "granucal simulate: %s\n", r.checkpoint_note);
-    if (r.resumed) fprintf(stderr, "granucal simulate: %g rpm resumed from %s\n", rpm, ck_path);
+    dem_status st;
+    dem_world *w = exp_drum_turn_bed(bed, 0, &turn, &r, &st);
+    if (!w) return fprintf(stderr, "granucal simulate: out of memory copying the bed\n"), 1;
     const char *status = st != DEM_OK ? "failed" : r.steady ? "ok" : "not steady";
     if (st != DEM_OK) fprintf(stderr, "granucal simulate: %g rpm: %s\n", rpm, dem_world_error(w));
     int bad = save(sub, y, &r, w, status);
@@ -118,32 +112,30 @@ static int turn_copy(const dem_world *bed, exp_drum_yaml *y, const exp_drum_def 
     return bad || st != DEM_OK;
 }
 
-int cal_simulate_drum(const char *path, int n_sets, char **sets, const char *out, const char *rpm_list,
+int cal_simulate_drum(const exp_drum_yaml *config, const char *out_dir, const char *rpm_list,
                       double checkpoint_every_s)
 {
     char err[1024], dir[1024];
     double rpms[32];
-    exp_drum_yaml *y = exp_drum_config_load(path, n_sets, sets, err, sizeof err);
-    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    exp_drum_yaml y = *config; // its rpm is each turn's in turn
     int n_rpm = rpm_list ? parse_rpm_list(rpm_list, rpms, 32, err, sizeof err) : 0;
-    if (n_rpm < 0) return fprintf(stderr, "granucal simulate: %s\n", err), exp_drum_config_free(y), 2;
-    if (n_rpm == 0) rpms[n_rpm++] = y->rpm;
+    if (n_rpm < 0) return fprintf(stderr, "granucal simulate: %s\n", err), 2;
+    if (n_rpm == 0) rpms[n_rpm++] = y.rpm;
     exp_drum_def def;
     exp_drum_run_opts run;
-    exp_drum_config_defs(y, &def, &run, err, sizeof err);
-    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/drum");
-    if (cal_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), exp_drum_config_free(y), 1;
+    exp_drum_config_defs(&y, &def, &run, err, sizeof err);
+    snprintf(dir, sizeof dir, "%s", out_dir ? out_dir : "results/runs/drum");
+    if (cal_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
     progress_state p = {isatty(2), 0, exp_wall_seconds()};
     dem_world *bed = exp_drum_fill(&def, show_progress, &p, err, sizeof err);
-    if (!bed) return fprintf(stderr, "\ngranucal simulate: %s\n", err), exp_drum_config_free(y), 1;
+    if (!bed) return fprintf(stderr, "\ngranucal simulate: %s\n", err), 1;
     fprintf(stderr, "%sgranucal simulate: bed of %zu granules settled after %.2f s; %s\n", p.tty ? "\n" : "",
             dem_world_granules(bed).count, dem_world_time(bed), dem_world_dt_report(bed));
     int bad = 0;
     if (n_rpm > 1) fputs("{\"experiment\": \"drum speed sweep\", \"runs\": [", stdout);
     for (int k = 0; k < n_rpm; ++k)
-        bad |= turn_copy(bed, y, &def, run, rpms[k], dir, n_rpm > 1, &p, stdout, k == 0, checkpoint_every_s);
+        bad |= turn_copy(bed, &y, &def, run, rpms[k], dir, n_rpm > 1, &p, stdout, k == 0, checkpoint_every_s);
     if (n_rpm > 1) fputs("]}\n", stdout);
     dem_world_destroy(bed);
-    exp_drum_config_free(y);
     return bad;
 }

@@ -15,6 +15,7 @@
 #include "exp_common.h"
 #include "exp_contact_rules.h"
 #include "exp_drum_bed.h"
+#include "exp_drum_turn.h"
 
 // How this environment's drum runs are counted in the progress.
 static cal_run_kind drum_kind(const cal_env *env) { return env->mapping ? CAL_RUN_MAP_DRUM : CAL_RUN_DRUM; }
@@ -316,31 +317,27 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
 {
     const cal_drum_case *c = &b->cases[r.c];
     const char *key = run_key(b, r);
-    exp_drum_run_opts run = cal_drum_run_opts(c, b->rpm[r.k]);
-    dem_world *w = own ? bed : dem_world_clone(bed);
-    if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
-    char ck_path[1300];
+    char ck_path[1300], what[48], prefix[80];
     checkpoint_path(b->env, key, ck_path, sizeof ck_path);
-    exp_drum_checkpoint ck = {ck_path, key, b->env->checkpoint_every_s};
-    if (ck.every_s > 0) run.checkpoint = &ck;
-    double t0 = exp_wall_seconds();
-    exp_drum_result res;
-    char what[48];
-    snprintf(what, sizeof what, "%g rpm, seed %llu", run.rpm, (unsigned long long)c->def.seed);
+    exp_drum_turn turn = {.def = &c->def, .run = cal_drum_run_opts(c, b->rpm[r.k]), .checkpoint_path = ck_path,
+                          .key = key, .checkpoint_every_s = b->env->checkpoint_every_s,
+                          .progress = exp_print_progress, .log_prefix = prefix};
+    snprintf(prefix, sizeof prefix, "[%s]", b->env->stage);
+    snprintf(what, sizeof what, "%g rpm, seed %llu", turn.run.rpm, (unsigned long long)c->def.seed);
     heartbeat h;
     heartbeat_start(&h, b->env->stage, what);
-    dem_status st = exp_drum_rotate(w, &c->def, &run, exp_print_progress, &h.printer, &res);
-    if (res.checkpoint_note[0]) fprintf(stderr, "[%s] %s\n", b->env->stage, res.checkpoint_note);
-    if (res.resumed)
-        fprintf(stderr, "[%s] %g rpm: resumed from its checkpoint (%.0f s of wall time saved)\n", b->env->stage,
-                run.rpm, res.earlier_wall_s);
+    turn.progress_ctx = &h.printer;
+    exp_drum_result res;
+    dem_status st;
+    dem_world *w = exp_drum_turn_bed(bed, own, &turn, &res, &st);
+    if (!w) return write_failed(b->env, key, "out of memory copying the settled bed"), 1;
     cal_record rec = {.key = (char *)key, .reason = ""};
     rec.status = st != DEM_OK ? "failed" : res.steady ? "ok" : "not steady";
     if (st != DEM_OK) rec.reason = (char *)dem_world_error(w);
     rec.angle_deg = res.angle_deg, rec.angle_sd_deg = res.angle_sd_deg;
     rec.csa_percent = res.csa_percent, rec.csa_sd_percent = res.csa_sd_percent;
     rec.steady = res.steady, rec.simulated_time_s = res.simulated_time_s;
-    rec.wall_time_s = exp_wall_seconds() - t0 + res.earlier_wall_s;
+    rec.wall_time_s = res.wall_time_s;
     rec.fill_wall_time_s = fill_s;
     rec.peak_rss_mb = exp_peak_rss_mb();
     rec.dt_s = dem_world_dt(w), rec.particle_steps = (double)res.particle_steps, rec.granules = (int)res.granules;

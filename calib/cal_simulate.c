@@ -16,6 +16,7 @@
 #include "dem_output.h"
 #include "exp_compress.h"
 #include "exp_cylinder_config.h"
+#include "exp_cylinder_runner.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
 #include "exp_silo.h"
@@ -202,14 +203,21 @@ static int run_scene_file(const char *path, const simulate_args *a)
     return rc;
 }
 
-// The experiments' runners, one per experiment, each the same shape. The
-// drum's is calib's own (cal_drum.c: its runs are keyed like the
-// calibration's store, and it takes --rpm-list and --checkpoint-every); the
-// others live with their experiment (experiments/exp_*), which knows nothing
-// of calib.
+// The experiments' runners, one per experiment: each loads its config into
+// definitions (exp_NAME_load) and hands them to the experiment's runner. The
+// drum's runner is calib's own (cal_drum.c: its checkpoints are keyed like
+// the calibration's store, and it takes --rpm-list and --checkpoint-every);
+// the others live with their experiment (experiments/exp_*), which knows
+// nothing of calib. Compression and the silo still load their config in
+// their runner (one file each, not yet split).
 static int run_drum(const char *path, const simulate_args *a)
 {
-    return cal_simulate_drum(path, a->n_sets, a->sets, a->out, a->rpm_list, a->checkpoint_every_s);
+    char err[1024];
+    exp_drum_yaml *y = exp_drum_config_load(path, a->n_sets, a->sets, err, sizeof err);
+    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    int rc = cal_simulate_drum(y, a->out, a->rpm_list, a->checkpoint_every_s);
+    exp_drum_config_free(y);
+    return rc;
 }
 static int run_compress(const char *path, const simulate_args *a)
 {
@@ -218,7 +226,11 @@ static int run_compress(const char *path, const simulate_args *a)
 static int run_silo(const char *path, const simulate_args *a) { return exp_silo_simulate(path, a->n_sets, a->sets, a->out); }
 static int run_cylinder(const char *path, const simulate_args *a)
 {
-    return exp_cylinder_simulate(path, a->n_sets, a->sets, a->out);
+    char err[1400];
+    exp_cylinder_def d;
+    if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err))
+        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    return exp_cylinder_simulate(&d, a->out);
 }
 
 // Every experiment `granucal simulate` runs: the first whose `claims` knows

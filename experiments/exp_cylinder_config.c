@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The poured cylinder (section 4.1) as a YAML scene: load, --set, validate,
-// run through exp_cylinder_run (the same pour as the calibration's stage 1),
-// report. See exp_cylinder_config.h.
+// The poured cylinder (section 4.1) as a YAML scene: load, --set, validate.
+// See exp_cylinder_config.h; its runner is exp_cylinder_runner.c.
 #include "exp_cylinder_config.h"
 
 #include <cyaml/cyaml.h>
@@ -13,14 +12,8 @@
 
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
-#include "exp_pour.h"
-#include "exp_result.h"
 #include "exp_scene.h"
 #include "exp_yaml.h"
-
-// exp_cylinder.c settles until the kinetic energy ratio drops below this
-// (its SETTLE_KE_RATIO) or 2 s have passed: above it the bed is not at rest.
-#define REST_KE_RATIO 1e-6
 
 typedef struct cylinder_yaml {
     char *experiment;
@@ -112,128 +105,5 @@ int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_de
         bad = exp_field_error(path, n_sets, sets, exp_message_field(msg, field), msg, err, len);
     }
     exp_yaml_free(&cylinder_schema, y);
-    return bad;
-}
-
-// ------------------------------------------------------------ run + report
-
-typedef struct progress_state {
-    int verbose;
-    double last_print, start;
-    double last_t, granule_seconds; ///< Σ granules × simulated time, for the particle-step estimate
-} progress_state;
-
-static void on_progress(const char *phase, double t, size_t granules, void *ctx)
-{
-    progress_state *p = ctx;
-    // exp_run_for reports after each chunk of steps, with the granules the chunk ran.
-    if (t > p->last_t) p->granule_seconds += (t - p->last_t) * (double)granules;
-    p->last_t = t;
-    if (!p->verbose) return;
-    double now = exp_wall_seconds();
-    if (now - p->last_print < 10.0) return;
-    p->last_print = now;
-    fprintf(stderr, "cylinder: %s t = %.2f s, %zu granules, wall %.0f s\n", phase, t, granules, now - p->start);
-}
-
-dem_world *exp_cylinder_pour_and_report(const exp_cylinder_def *d, int verbose, exp_cylinder_result *r,
-                                        exp_cylinder_report *rep, char *err, size_t len)
-{
-    memset(rep, 0, sizeof *rep);
-    progress_state p = {verbose, 0, exp_wall_seconds(), 0, 0};
-    p.last_print = p.start;
-    dem_world *w = exp_cylinder_run(d, on_progress, &p, r, err, len);
-    rep->wall_time_s = exp_wall_seconds() - p.start;
-    if (!w) return NULL;
-    dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
-    rep->ke_ratio = exp_ke_ratio(w, gsd.median_diameter);
-    rep->particle_steps_est = dem_world_dt(w) > 0 ? p.granule_seconds / dem_world_dt(w) : 0;
-    rep->bed_surface_m = exp_bed_surface(w, 0);
-    dem_granules_view g = dem_world_granules(w);
-    for (size_t i = 0; i < g.count; ++i) rep->bed_top_m = fmax(rep->bed_top_m, g.position[i].y + g.radius[i]);
-    return w;
-}
-
-static void json_number(FILE *f, const char *key, double v, const char *fmt)
-{
-    fprintf(f, ", \"%s\": ", key);
-    if (isfinite(v)) fprintf(f, fmt, v);
-    else fputs("null", f); // JSON has no NaN (no interior granule at a coarse lambda)
-}
-
-void exp_cylinder_write_json(FILE *f, const exp_cylinder_def *d, const exp_cylinder_result *r,
-                             const exp_cylinder_report *rep, const dem_world *w)
-{
-    char effects[1024];
-    dem_world_describe_features(w, effects, sizeof effects);
-    fprintf(f,
-            "{\"experiment\": \"cylinder\", \"status\": \"%s\", \"k_n\": %g, \"wall_k_n\": %g, \"mu_s\": %g, "
-            "\"mu_r\": %g, \"xi\": %g, \"lambda\": %g, \"seed\": %llu, \"diameter_m\": %g, \"depth_m\": %g, "
-            "\"granules\": %zu",
-            rep->ke_ratio < REST_KE_RATIO ? "ok" : "not at rest", d->granule.k_n, exp_boundary_stiffness(d->granule.k_n), d->granule.mu_s,
-            d->granule.mu_r, d->granule.xi, d->lambda, (unsigned long long)d->seed, d->diameter, d->depth,
-            r->granules);
-    json_number(f, "coordination", r->coordination, "%.4f");
-    json_number(f, "coordination_interior", r->coordination_interior, "%.4f");
-    json_number(f, "wall_contacts_per_granule", r->wall_contacts_per_granule, "%.4f");
-    json_number(f, "coordination_with_walls", r->coordination + r->wall_contacts_per_granule, "%.4f");
-    json_number(f, "solid_fraction", r->solid_fraction, "%.4f");
-    json_number(f, "bed_surface_m", rep->bed_surface_m, "%.5g");
-    json_number(f, "bed_top_m", rep->bed_top_m, "%.5g");
-    json_number(f, "ke_ratio", rep->ke_ratio, "%.3g");
-    fprintf(f,
-            ", \"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"particle_steps_est\": %.0f, \"dt_s\": %.6g, "
-            "\"effects\": \"%s\"}\n",
-            r->simulated_time_s, rep->wall_time_s, rep->particle_steps_est, dem_world_dt(w), effects);
-}
-
-int exp_cylinder_write_outputs(const char *dir, const exp_cylinder_def *d, const exp_cylinder_result *r,
-                               const exp_cylinder_report *rep, const dem_world *w, char *err, size_t len)
-{
-    char path[1100], tmp[1200];
-    if (exp_mkdirs(dir, err, len)) return 1;
-    if (exp_result_write_h5(dir, w, err, len)) return 1;
-    snprintf(path, sizeof path, "%s/result.json", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (f) exp_cylinder_write_json(f, d, r, rep, w);
-    if (!f || fclose(f) != 0 || rename(tmp, path) != 0) {
-        remove(tmp);
-        return exp_fail(err, len, "cannot write '%s'", path);
-    }
-    return 0;
-}
-
-int exp_cylinder_simulate(const char *path, int n_sets, char **sets, const char *out)
-{
-    char err[1400], dir[1024];
-    exp_cylinder_def d;
-    if (exp_cylinder_load(path, n_sets, sets, &d, err, sizeof err))
-        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/cylinder");
-    if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    exp_cylinder_result r;
-    exp_cylinder_report rep;
-    dem_world *w = exp_cylinder_pour_and_report(&d, 1, &r, &rep, err, sizeof err);
-    if (!w) {
-        fprintf(stderr, "granucal simulate: %s\n", err);
-        printf("{\"experiment\": \"cylinder\", \"status\": \"failed\", \"error\": \"");
-        for (const char *c = err; *c; ++c) // a JSON string: escape quotes, backslashes, control characters
-            if (*c == '"' || *c == '\\') printf("\\%c", *c);
-            else if ((unsigned char)*c < 0x20) printf("\\u%04x", (unsigned)(unsigned char)*c);
-            else putchar(*c);
-        printf("\"}\n");
-        return 1;
-    }
-    fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));
-    int bad = exp_cylinder_write_outputs(dir, &d, &r, &rep, w, err, sizeof err);
-    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
-    exp_cylinder_write_json(stdout, &d, &r, &rep, w);
-    if (!(rep.ke_ratio < REST_KE_RATIO))
-        fprintf(stderr,
-                "granucal simulate: the settle stopped at its time limit (kinetic energy ratio %.3g, at rest below "
-                "%.0e): status \"not at rest\"; the contacts are counted as they are\n",
-                rep.ke_ratio, REST_KE_RATIO);
-    dem_world_destroy(w);
     return bad;
 }

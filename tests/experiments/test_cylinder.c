@@ -27,6 +27,7 @@
 #include "cal_sim.h"
 #include "dem_scaling.h"
 #include "exp_cylinder_config.h"
+#include "exp_cylinder_runner.h"
 
 static void source_path(const char *rel, char *path, size_t len)
 {
