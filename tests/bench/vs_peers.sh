@@ -135,17 +135,20 @@ for code in ('liggghts', 'lammps'):
     if not runs:
         print("turning_step %s none (no run measured)" % code); continue
     f0, ref, _ = runs[0]
-    chosen, broken = f0, False
+    chosen, broken, passing = f0, False, f0
     for f, r, tol in runs:
         da, dc = num(r['angle_deg']) - num(ref['angle_deg']), num(r['csa_pct']) - num(ref['csa_pct'])
         same = abs(da) <= num(tol['angle_deg']) and abs(dc) <= num(tol['csa_pct'])
         broken |= not same
         if not broken: chosen = f
+        if same: passing = f
         gd = num(r['angle_deg']) - num(g['angle_deg']) if g else float('nan')
         print("  %-9s %.4g dt_crit: %6.2f deg, %6.2f %%; from its %.4g dt_crit run %+.2f deg %+.2f pts (tolerance %s, %s): %s;"
               " from granucal %+.2f deg" % (code, f, num(r['angle_deg']), num(r['csa_pct']), f0, da, dc,
                                              tol['angle_deg'], tol['csa_pct'], "same drum" if same else "NOT the same drum", gd))
     print("turning_step %s %.4g" % (code, chosen))
+    # One bed per step: a step past the first that failed may pass on noise, or fail on it. Both said.
+    print("largest_passing_step %s %.4g" % (code, passing))
 EOF
 }
 
@@ -420,10 +423,12 @@ import csv, os, statistics as st, sys
 raw, beds = sys.argv[1], sys.argv[2]
 dtc, dtnet, mass, d50 = map(float, sys.argv[3:7])
 turning = {}  # each peer's step on the turning drum (--turning-scan), where it was measured
+passing = {}  # the largest step that passed at all (the rule above stops at the first failure)
 if os.path.exists(sys.argv[7]):
     for line in open(sys.argv[7]):
         w = line.split()
         if len(w) == 3 and w[0] == 'turning_step' and w[2] != 'none': turning[w[1]] = float(w[2])
+        if len(w) == 3 and w[0] == 'largest_passing_step': passing[w[1]] = float(w[2])
 rows = list(csv.DictReader(open(raw)))
 med = lambda xs: st.median(xs) if xs else float('nan')
 def sel(**kw): return [r for r in rows if all(r[k] == v for k, v in kw.items())]
@@ -497,6 +502,10 @@ for th in ('1', '2'):
         if code == 'granucal': f = dtnet / dtc  # the engine's own pick (network step)
         if ps and f:
             print("  %-9s %s thr: dt = %.3f dt_crit -> %.0f s per simulated second" % (code, th, f, 20000 / (f * dtc) / ps))
+        if ps and passing.get(code, f) != f:
+            g = passing[code]
+            print("  %-9s %s thr: dt = %.3f dt_crit (its largest step that passed) -> %.0f s per simulated second" % (
+                code, th, g, 20000 / (g * dtc) / ps))
 
 print("\n== accuracy guard (granucal, after the timed steps at 40 rpm)")
 bad = 0
