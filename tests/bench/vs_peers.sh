@@ -493,19 +493,19 @@ for n in sorted({int(r['N']) for r in rows if r['rep'].isdigit() and r['variant'
                                      ", ".join("%.2f" % x for x in pairs), med(pairs)))
 
 # A peer's step: the largest that keeps its turning drum's answer (--turning-scan, turning_steps.txt),
-# else the largest that keeps a bed at rest (flatters a peer: LIGGGHTS' drum fluidises at 0.6).
+# else the largest that keeps a bed at rest (can flatter a peer: a 4 rpm LIGGGHTS drum on this bench's
+# own input fluidised at 0.6, where its bed at rest held; results/benchmarks/turning_scan/README.md).
 basis = "its turning drum's answer (turning_steps.txt)" if turning else "a bed at rest (no turning scan in this --out)"
 print("\n== wall time to simulate 1 s of the drum at N = 20000; a peer's step: the largest that keeps " + basis)
 for th in ('1', '2'):
     for code in ('granucal', 'liggghts', 'lammps'):
         ps = summary.get((code, 20000, th)); f = turning.get(code, scan.get(code))
         if code == 'granucal': f = dtnet / dtc  # the engine's own pick (network step)
-        if ps and f:
-            print("  %-9s %s thr: dt = %.3f dt_crit -> %.0f s per simulated second" % (code, th, f, 20000 / (f * dtc) / ps))
-        if ps and passing.get(code, f) != f:
-            g = passing[code]
-            print("  %-9s %s thr: dt = %.3f dt_crit (its largest step that passed) -> %.0f s per simulated second" % (
-                code, th, g, 20000 / (g * dtc) / ps))
+        steps = [(f, "")] + ([(passing[code], " (its largest step that passed)")] if passing.get(code, f) != f else [])
+        for step, why in steps:
+            if ps and step:
+                print("  %-9s %s thr: dt = %.3f dt_crit%s -> %.0f s per simulated second" % (
+                    code, th, step, why, 20000 / (step * dtc) / ps))
 
 print("\n== accuracy guard (granucal, after the timed steps at 40 rpm)")
 bad = 0
