@@ -9,9 +9,12 @@
 // from the key's digits too, but only the search's own μ (the stage_*.yaml files, 17 digits;
 // simulations.csv has 6) reproduces its bits: the line "this run ... record" says whether it did
 // (results/benchmarks/averaging_ab.md).
-//   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES
+//   usage: bench_drum_averaging CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES [TURN_ON_S]
 //   (granule stage: the drum lined with granules; BED 0, 1, 2: the tier's beds, seeds config seed + BED;
-//    TIMES e.g. 0,1,2,3,4,6,8)
+//    TIMES e.g. 0,1,2,3,4,6,8). TURN_ON_S: average that long after the steady test instead of the
+//    tier's average_time (a run's trajectory does not depend on when it stops, so the record is still
+//    checked, against the mean over the tier's own averaging); it also prints the mean of each 2 s block
+//    after the steady test, which shows a drift the running mean smooths.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,8 +51,8 @@ static void mean_over(const series *s, int from, int to, double *angle, double *
 
 int main(int argc, char **argv)
 {
-    if (argc != 10)
-        return fprintf(stderr, "usage: %s CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES\n", argv[0]), 2;
+    if (argc != 10 && argc != 11)
+        return fprintf(stderr, "usage: %s CONFIG TIER K_N MU_S MU_R RPM BED STORE TIMES [TURN_ON_S]\n", argv[0]), 2;
     char err[1024], key[4096];
     cal_config *c = cal_config_load(argv[1], argv[2], err, sizeof err);
     if (!c) return fprintf(stderr, "%s\n", err), 1;
@@ -65,6 +68,11 @@ int main(int argc, char **argv)
     exp_drum_run_opts o = cal_drum_run_opts(&d, rpm);
     series s = {0};
     o.on_sample = keep, o.sample_ctx = &s;
+    const double tier_average_time = o.average_time;
+    if (argc == 11 && atof(argv[10]) > o.average_time) {
+        o.max_time += atof(argv[10]) - o.average_time; // the steady test may take as long as before
+        o.average_time = atof(argv[10]);
+    }
     dem_world *bed = exp_drum_fill(&d.fill, NULL, NULL, err, sizeof err);
     if (!bed) return fprintf(stderr, "%s\n", err), 1;
     // A copy of the settled bed, as the calibration turns one (calib/cal_sim.c; a copy steps to the
@@ -76,6 +84,8 @@ int main(int argc, char **argv)
         return fprintf(stderr, "the run failed or was not steady\n"), 1;
     int per_window = (int)(o.window / o.sample_interval + 0.5), avg = (int)(o.average_time / o.sample_interval + 0.5);
     int steady_at = s.n - avg, from = steady_at - 2 * per_window;
+    // What the tier's own run reported: the mean over its averaging (the same sum as exp_drum.c's).
+    mean_over(&s, from, steady_at + (int)(tier_average_time / o.sample_interval + 0.5), &r.angle_deg, &r.csa_percent);
     const int same = rec.angle_deg == r.angle_deg && rec.csa_percent == r.csa_percent;
     printf("record: angle %.17g, CSA %.17g; this run: angle %.17g, CSA %.17g (%s the record); steady test held at "
            "%.2f s of turning\n",
@@ -89,6 +99,13 @@ int main(int argc, char **argv)
         mean_over(&s, from, to, &angle, &csa);
         printf("average_time=%g turned_s=%.2f angle_deg=%.17g csa_percent=%.17g\n", T, to * o.sample_interval, angle,
                csa);
+    }
+    const int block = (int)(2.0 / o.sample_interval + 0.5);
+    for (int b0 = steady_at; b0 + block <= s.n; b0 += block) {
+        double angle, csa;
+        mean_over(&s, b0, b0 + block, &angle, &csa);
+        printf("block_from_s=%.2f block_to_s=%.2f angle_deg=%.4f csa_percent=%.4f\n", b0 * o.sample_interval,
+               (b0 + block) * o.sample_interval, angle, csa);
     }
     free(list), free(s.m);
     cal_record_free(&rec);
