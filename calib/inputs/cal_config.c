@@ -14,7 +14,6 @@
 #include "dem_contact.h"
 #include "exp_common.h"
 #include "exp_gsd_table.h"
-#include "exp_scene.h"
 #include "exp_yaml.h"
 
 static const cyaml_schema_value_t float_entry = {CYAML_VALUE_FLOAT(CYAML_FLAG_DEFAULT, double)};

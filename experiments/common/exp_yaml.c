@@ -8,7 +8,6 @@
 #include <string.h>
 
 #include "exp_common.h"
-#include "exp_scene.h"
 
 typedef struct log_capture {
     char problem[256]; ///< the first error libcyaml reported
@@ -97,4 +96,40 @@ int exp_yaml_starts_with(const char *path, const char *first)
     }
     if (f) fclose(f);
     return yes;
+}
+
+int exp_yaml_line_of(const char *path, const char *key, int from_line)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return 0;
+    char line[1024], pattern[80];
+    snprintf(pattern, sizeof pattern, "%s:", key);
+    int n = 0, found = 0;
+    while (!found && fgets(line, sizeof line, f)) {
+        ++n;
+        char *hit = n >= from_line ? strstr(line, pattern) : NULL;
+        if (hit && (hit == line || strchr(" \t{,-", hit[-1]))) found = n;
+    }
+    fclose(f);
+    return found;
+}
+
+int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
+                    size_t len)
+{
+    size_t n = strlen(field);
+    for (int k = n_sets - 1; k >= 0; --k)
+        if (strncmp(sets[k], field, n) == 0 && sets[k][n] == '=')
+            return exp_fail(err, len, "%s: --set %s: %s", path, sets[k], msg);
+    int line = exp_yaml_line_of(path, field, 1);
+    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
+    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
+}
+
+const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN])
+{
+    size_t n = strcspn(msg, " =:");
+    snprintf(field, EXP_FIELD_LEN, "%.*s", (int)(n < EXP_FIELD_LEN ? n : EXP_FIELD_LEN - 1), msg);
+    const char *leaf = strrchr(field, '.');
+    return leaf ? leaf + 1 : field;
 }

@@ -12,7 +12,6 @@
 
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
-#include "exp_scene.h"
 #include "exp_yaml.h"
 
 typedef struct cylinder_yaml {

@@ -16,8 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "exp_scene.h"
-
 static const cyaml_schema_field_t material_fields[] = {
     CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_POINTER, exp_material_yaml, name, 1, 31),
     CYAML_FIELD_FLOAT("mu_s", CYAML_FLAG_DEFAULT, exp_material_yaml, mu_s),

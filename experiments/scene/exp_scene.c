@@ -6,6 +6,7 @@
 
 #include "exp_common.h"
 #include "exp_contact_rules.h"
+#include "exp_yaml.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,34 +92,6 @@ static const cyaml_config_t *config_for(log_buffer *b)
     return &cfg;
 }
 
-int exp_yaml_line_of(const char *path, const char *key, int from_line)
-{
-    FILE *f = fopen(path, "r");
-    if (!f) return 0;
-    char line[1024], pattern[80];
-    snprintf(pattern, sizeof pattern, "%s:", key);
-    int n = 0, found = 0;
-    while (!found && fgets(line, sizeof line, f)) {
-        ++n;
-        char *hit = n >= from_line ? strstr(line, pattern) : NULL;
-        if (hit && (hit == line || strchr(" \t{,-", hit[-1]))) found = n;
-    }
-    fclose(f);
-    return found;
-}
-
-int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
-                    size_t len)
-{
-    size_t n = strlen(field);
-    for (int k = n_sets - 1; k >= 0; --k)
-        if (strncmp(sets[k], field, n) == 0 && sets[k][n] == '=')
-            return exp_fail(err, len, "%s: --set %s: %s", path, sets[k], msg);
-    int line = exp_yaml_line_of(path, field, 1);
-    if (line > 0) return exp_fail(err, len, "%s:%d: %s: %s", path, line, field, msg);
-    return exp_fail(err, len, "%s: %s: %s", path, field, msg);
-}
-
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len)
 {
@@ -130,14 +103,6 @@ int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, co
     char sub[256];
     if (dem_contact_params_check(out, sub, sizeof sub)) return exp_fail(err, err_len, "%s.%s", where, sub);
     return 0;
-}
-
-const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN])
-{
-    size_t n = strcspn(msg, " =:");
-    snprintf(field, EXP_FIELD_LEN, "%.*s", (int)(n < EXP_FIELD_LEN ? n : EXP_FIELD_LEN - 1), msg);
-    const char *leaf = strrchr(field, '.');
-    return leaf ? leaf + 1 : field;
 }
 
 // Point a message at the line of its field: "path:line: field...: why".

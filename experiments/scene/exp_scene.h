@@ -59,22 +59,4 @@ dem_world *exp_scene_build(const exp_scene *s, char *err, size_t err_len);
 int exp_contact_from_yaml(const exp_contact_yaml *y, dem_contact_params *out, const char *where, char *err,
                           size_t err_len);
 
-/// Line (1-based) on which `key:` first appears in a file at or after
-/// `from_line`, or 0: used to point messages at the offending line when the
-/// YAML library reports only the field.
-int exp_yaml_line_of(const char *path, const char *key, int from_line);
-
-/// The field a check's message starts with ("granule_contact.mu_s = -1: ...",
-/// "walls[0].contact.mu_s = ..."): its whole path into `field`, and, returned,
-/// its last component (a pointer into `field`), the key to look up in the file.
-enum { EXP_FIELD_LEN = 64 };
-const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN]);
-
-/// The error for a config field whose value is bad, pointed at where the value
-/// came from: "PATH: --set FIELD=V: MSG" when the last `--set` of that field
-/// (among sets[0..n_sets)) gave it, else "PATH:LINE: FIELD: MSG" at the field's
-/// line in the file ("PATH: FIELD: MSG" if the line is not found). Always 1.
-int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
-                    size_t len);
-
 #endif

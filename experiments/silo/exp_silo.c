@@ -13,7 +13,6 @@
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_result.h"
-#include "exp_scene.h"
 #include "exp_yaml.h"
 
 exp_silo_def exp_default_silo_def(void)
