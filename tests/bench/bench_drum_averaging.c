@@ -20,8 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cal_case_runs.h"
 #include "cal_config.h"
-#include "cal_sim.h"
 #include "cal_store.h"
 #include "exp_drum.h"
 
@@ -75,7 +75,7 @@ int main(int argc, char **argv)
     }
     dem_world *bed = exp_drum_fill(&d.fill, NULL, NULL, err, sizeof err);
     if (!bed) return fprintf(stderr, "%s\n", err), 1;
-    // A copy of the settled bed, as the calibration turns one (calib/cal_sim.c; a copy steps to the
+    // A copy of the settled bed, as the calibration turns one (calib/runs/cal_case_runs.c; a copy steps to the
     // same bits as the bed itself, tests/physics/test_clone.c, and did here).
     dem_world *w = dem_world_clone(bed);
     if (!w) return fprintf(stderr, "out of memory\n"), 1;

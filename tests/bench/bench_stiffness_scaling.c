@@ -13,7 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cal_sim.h"
+#include "cal_case_runs.h"
 #include "cal_stages.h"
 #include "exp_plot.h"
 

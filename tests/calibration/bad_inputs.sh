@@ -111,7 +111,7 @@ for c in calibrate simulate measure "study fidelity" synthesize; do
     else echo "FAIL $c $bad: exit $code, wanted one line naming '$bad' and \`granucal $c --help\`: $msg"; fails=$((fails + 1)); fi
   done
 done
-# A bad value of any command's option (calib/cal_options.c reads them all from each command's
+# A bad value of any command's option (calib/cli/cal_options.c reads them all from each command's
 # table): one line naming the option, the value and what it accepts, exit 2; the help lists it.
 usage_error() { # usage_error WANT ARGS...: exit 2, one line on stderr holding WANT
   local want=$1; shift

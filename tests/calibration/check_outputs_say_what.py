@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-# Every output of a calibration says what it is (calib/cal_status.h):
+# Every output of a calibration says what it is (calib/outputs/cal_status.h):
 #   check_outputs_say_what.py RUN_DIR --tier T --purpose calibration|demonstration --data "angle lab / CSA synthetic"
 # - calibrated_parameters.csv: every row carries tier, lambda, data and purpose as given, and a status;
 #   every friction row's status follows from its own numbers (value, identified range, not-excluded

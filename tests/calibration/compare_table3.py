@@ -37,7 +37,7 @@ def stage1_resolved(run_dir):
 
 
 def judge_status(rule, paper, got):
-    """A row the data did not choose (its status column, calib/cal_status.h) is no value to score:
+    """A row the data did not choose (its status column, calib/outputs/cal_status.h) is no value to score:
     (verdict, what was measured), or None for a row whose value stands."""
     status = got.get('status') or 'calibrated'
     if status in ('calibrated', 'input', 'derived') or rule == 'carried':

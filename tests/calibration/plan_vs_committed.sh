@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `granucal calibrate --plan`'s EXPECTED cost against what the committed standard run
 # (results/calibration-standard/) measured: within 30 % in core-hours and in wall time, or
-# the cost model (calib/cal_plan.c, the planner in calib/cal_calibrate.c) has drifted.
+# the cost model (calib/runs/cal_plan.c, the planner in calib/cli/cal_cmd_calibrate.c) has drifted.
 # The plan is made from that run's own config and data copies and its store (where stage
 # 1's cylinders lie: the plan takes k_n from them, as the run did); nothing is simulated.
 #   Core-hours: the plan's whole calibration against the distinct records of its

@@ -23,8 +23,8 @@
 
 #include <cmocka.h>
 
+#include "cal_case_runs.h"
 #include "cal_config.h"
-#include "cal_sim.h"
 #include "dem_scaling.h"
 #include "exp_cylinder_config.h"
 #include "exp_cylinder_runner.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// libFuzzer target: the lab data loader (calib/cal_data.c, libcsv) on any
+// libFuzzer target: the lab data loader (calib/inputs/cal_data.c, libcsv) on any
 // bytes, read as a repose-angle file and as an occupied-area file.
 // Invariant: cal_series_load either accepts the file, and then every point
 // is a valid measurement (what the loader promises its callers), or refuses

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: the YAML loaders (libcyaml) on any bytes. Every input is
-// read by each of them: the calibration config (calib/cal_config.c, with and
-// without a --tier override), the drum experiment (experiments/
-// exp_drum_config.c, with and without --set overrides) and the explicit scene
-// (experiments/exp_scene.c).
+// read by each of them: the calibration config (calib/inputs/cal_config.c,
+// with and without a --tier override), the drum experiment
+// (experiments/drum/exp_drum_config.c, with and without --set overrides) and
+// the explicit scene (experiments/scene/exp_scene.c).
 // Invariant: a loader either accepts the file, and then what it returns
 // holds what it validated (every number finite and in its range: the values
 // the simulations will use), or refuses it with a non-empty message naming

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fuzz the input loaders with libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer
-# (and LeakSanitizer) for a bounded time each: fuzz_csv (calib/cal_data.c) and
-# fuzz_yaml (calib/cal_config.c, experiments/exp_drum_config.c, experiments/exp_scene.c).
+# (and LeakSanitizer) for a bounded time each: fuzz_csv (calib/inputs/cal_data.c) and
+# fuzz_yaml (calib/inputs/cal_config.c, experiments/drum/exp_drum_config.c,
+# experiments/scene/exp_scene.c).
 #
 #   tests/fuzz/run_fuzz.sh [SECONDS_PER_TARGET] [csv|yaml ...]     (default: 60 s, both)
 #

@@ -39,8 +39,8 @@ awk 'BEGIN {print "t_s,contacts,ke_translational_J,ke_rotational_J,discharged"}
   "$work/liggghts/log.liggghts" > "$work/liggghts.csv"
 
 # 3. Compare.
-cc -O2 -std=c11 -I"$root/experiments" -I"$root/engine" "$root/tests/peers/silo/compare_silo.c" \
-   "$root/experiments/exp_plot.c" $(pkg-config --cflags --libs plplot) -lm -o "$work/compare_silo"
+cc -O2 -std=c11 -I"$root/experiments/plot" -I"$root/engine" "$root/tests/peers/silo/compare_silo.c" \
+   "$root/experiments/plot/exp_plot.c" $(pkg-config --cflags --libs plplot) -lm -o "$work/compare_silo"
 cp "$work/granucal/series.csv" "$out/granucal_series.csv"
 cp "$work/liggghts.csv" "$out/liggghts_series.csv"
 cp "$work/granucal.json" "$out/granucal_result.json"

@@ -15,12 +15,12 @@
 
 #include <cmocka.h>
 
+#include "cal_case_runs.h"
 #include "cal_config.h"
 #include "cal_data.h"
-#include "cal_sim.h"
+#include "cal_files.h"
 #include "cal_stages.h"
 #include "cal_store.h"
-#include "cal_util.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
 

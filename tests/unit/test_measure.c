@@ -12,7 +12,7 @@
 #include <cmocka.h>
 #include <math.h>
 
-#include "exp_measure.h"
+#include "exp_face_measure.h"
 #include "dem_vec.h"
 
 #define DRUM_R 0.05  // m, the paper's 100 mm drum

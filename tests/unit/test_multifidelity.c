@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The two-fidelity search (calib/cal_multifidelity.c) on analytic responses,
+// The two-fidelity search (calib/methods/cal_multifidelity.c) on analytic responses,
 // where the expensive tier's optimum is known exactly: an "angle" and two
 // "CSA" values, smooth in (u, v), the cheap tier the same plus a bias it
 // cannot know. The objective is the friction stage's form: squared z-scores

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The command line of every granucal command (calib/cal_options.c): each kind
+// The command line of every granucal command (calib/cli/cal_options.c): each kind
 // of value stored where its row says, a bad one refused in one line naming the
 // option, the value and its range, and --help printed from the same rows.
 #include <setjmp.h>

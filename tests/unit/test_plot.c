@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Every kind of figure granucal draws (experiments/exp_plot through
-// calib/cal_figures and directly), from small synthetic data: each file must
+// Every kind of figure granucal draws (experiments/plot/exp_plot through
+// calib/outputs/cal_figures and directly), from small synthetic data: each file must
 // be a PNG, more than a few KB, and more than a few colours (a blank or
 // single-colour page means nothing was drawn); an unwritable path must fail
 // with a message naming the file. GRANUCAL_PLOT_DIR keeps the figures in that

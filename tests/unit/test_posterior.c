@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The posterior of a friction stage (calib/cal_posterior.c) on maps whose
+// The posterior of a friction stage (calib/search/cal_posterior.c) on maps whose
 // posterior is known in closed form: an angle linear in u with a Gaussian
 // spread (the posterior of u a Gaussian, of v flat: uniform in log10 μr), and
 // the kriging's variance growing away from its runs.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// A calibration's progress (calib/cal_progress.c): the counts over stages, the
+// A calibration's progress (calib/runs/cal_progress.c): the counts over stages, the
 // time left from the measured cost per kind of simulation, worked by hand.
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// What each value of a calibrated table is (calib/cal_status.c): a value the
+// What each value of a calibrated table is (calib/outputs/cal_status.c): a value the
 // data did not choose is never called calibrated. Each case is built by hand
 // from the definitions (a search bound, an identified range, the interval no
 // candidate excludes), including the standard run's own rows.

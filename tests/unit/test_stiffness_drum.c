@@ -15,9 +15,9 @@
 
 #include <cmocka.h>
 
-#include "cal_sim.h"
+#include "cal_case_runs.h"
+#include "cal_files.h"
 #include "cal_stages.h"
-#include "cal_util.h"
 #include "exp_common.h"
 
 static const double candidates[] = {10, 50}; // soft: cheap (a stiffer bed needs a smaller step)

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The peers' side of tests/peers/drum_peers.sh: the dumped positions of a
 // LIGGGHTS or LAMMPS run of an exported deck (liggghts_drum.in,
-// lammps_drum.in) measured with granucal's own raster (exp_measure.h), pixel
+// lammps_drum.in) measured with granucal's own raster (exp_face_measure.h), pixel
 // and closing exactly as exp_drum_measure_now does.
 //
 //   drum_peers measure DRUM.yaml DUMP [--set KEY=VALUE ...]
@@ -15,7 +15,7 @@
 
 #include "exp_drum.h"
 #include "exp_drum_config.h"
-#include "exp_measure.h"
+#include "exp_face_measure.h"
 
 static int load(const char *cfg, int n_sets, char **sets, exp_drum_def *d, exp_drum_run_opts *run)
 {

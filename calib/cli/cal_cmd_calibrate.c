@@ -1,0 +1,761 @@
+// SPDX-License-Identifier: MIT
+// `granucal calibrate`: the product. Validates every input, then runs the
+// stages, each from the result store where it can, and writes the table.
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include <cyaml/cyaml.h>
+
+#include "cal_commands.h"
+#include "cal_files.h"
+#include "cal_mpi.h"
+#include "cal_options.h"
+#include "cal_plan.h"
+#include "cal_report.h"
+#include "exp_common.h"
+#include "exp_yaml.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static const char synopsis[] =
+    "usage: granucal calibrate [CONFIG.yaml] [options]\n"
+    "\n"
+    "Calibrate the linear spring-dashpot model with sliding and rolling friction of a\n"
+    "powder from rotating-drum measurements (Tiscar et al. 2019, section 4):\n"
+    "  1. stiffness: coordination number of a poured cylinder for each candidate k_n;\n"
+    "     keep the smallest k whose CN is within the seed-to-seed noise of the stiff limit;\n"
+    "  2. granule-granule (mu_s, mu_r) in the drum lined with granules: NLopt COBYLA\n"
+    "     minimises the occupied-area (CSA) misfit over the speeds subject to the dynamic\n"
+    "     angle of repose matching the lab's (a tier with `angle_rule: misfit` puts the\n"
+    "     angle into the misfit instead, for runs whose angle is as noisy as the band);\n"
+    "  3. each wall material's (mu_s, mu_r), granule-granule frozen, the same way.\n"
+    "After each search, the best mu_s is run at mu_r's two search bounds, and every\n"
+    "candidate's chi^2 (angle and CSA, by the lab's and the tier's measured spreads)\n"
+    "gives the identified range: the candidates within Delta chi^2 = 3.84 of the best,\n"
+    "which these measurements cannot tell apart. A wall mu_r the drum does not resolve\n"
+    "shows as a range that reaches the search bound, not as one noisy point.\n"
+    "A tier with `map_tier: NAME` (the standard tier) searches across two tiers: NAME's\n"
+    "whole search maps the plane, then this tier runs only where that map, corrected by\n"
+    "the discrepancy measured between the two at those runs, puts the optimum, until a\n"
+    "run agrees with the corrected map within the data's noise (max_evaluations runs).\n"
+    "\n"
+    "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
+    "(repose_angle.csv: surface,rpm,angle_deg,angle_sd_deg; occupied_area.csv:\n"
+    "surface,rpm,csa_percent,csa_sd_percent), the powder, the candidates, the bounds and\n"
+    "the fidelity tiers. Every input is checked before the first simulation.\n";
+
+static const char epilogue[] =
+    "Progress: one line per simulation on stderr, ending with the step of the whole\n"
+    "calibration (stiffness, granule, each wall material), the simulations done of the\n"
+    "most it may take, and the time left at most, from the measured cost of each kind of\n"
+    "simulation so far (stored ones included) shared by the simulations run at once.\n"
+    "\n"
+    "Resuming: every simulation is stored in OUT/store under a hash of everything that\n"
+    "defines it; run the same command again after a kill and nothing finished is rerun.\n"
+    "A drum run killed while turning resumes from its last checkpoint (OUT/store/*.turn.h5)\n"
+    "and ends as it would have uninterrupted (bit for bit; its bed is settled again).\n"
+    "A damaged record (cut short, not YAML) is moved to OUT/store/damaged/, kept, with\n"
+    "one line saying so, and only its simulation runs again.\n"
+    "Across machines: mpirun -np N granucal calibrate ... deals the simulations of each\n"
+    "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
+    "\n"
+    "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max,\n"
+    "not_excluded_min/max, status and flags: calibrated, one-sided at a search bound,\n"
+    "not identified, not a result; the run's tier, lambda, data and purpose on every\n"
+    "row; the posterior's median and 95 % credible interval), simulations.csv,\n"
+    "report.md (every candidate, its chi^2, the ranges, the posterior, which\n"
+    "measurement moves with which friction), cn_vs_k.png, angle_map_*.png,\n"
+    "csa_vs_rpm_*.png, convergence_*.png, posterior_*.png, liggghts_parameters.in,\n"
+    "lammps_parameters.in, and complete decks of the drum: liggghts_drum.in,\n"
+    "lammps_drum.in. A tier marked `purpose: demonstration` (quick, ci, check) makes\n"
+    "a demonstration, never a calibration, and every output says so.\n";
+
+typedef struct options {
+    const char *config, *tier, *stage, *material, *out, *data;
+    int jobs;
+    double checkpoint_every_s;
+    double budget_hours; ///< refuse a plan predicted to take longer (NAN: no limit)
+    int plan_only;       ///< --plan: stop after printing the plan
+} options;
+
+static const char *const stages[] = {"all", "stiffness", "granule", "wall", NULL};
+
+// --material NAME: that wall material alone, so the wall stage alone (a later --stage still wins).
+static int take_material(const char *text, void *context)
+{
+    options *o = context;
+    o->material = text, o->stage = "wall";
+    return 0;
+}
+
+// 0: parsed; -1: --help printed; else the exit status of a usage error.
+static int parse_options(int argc, char **argv, options *o)
+{
+    *o = (options){.config = "configs/calibration.yaml", .stage = "all", .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S,
+                   .budget_hours = NAN, .jobs = cal_default_jobs()};
+    const cal_option table[] = {
+        cal_option_tier(&o->tier, "fidelity tier from the config (ci, quick, standard, paper, ...)"),
+        {.name = "stage", .kind = CAL_OPT_CHOICE, .text = &o->stage, .choices = stages, .value = "STAGE",
+         .help = "the stage to run (default all); a later stage reads the earlier stages' results from OUT, else "
+                 "the config's values"},
+        {.name = "material", .kind = CAL_OPT_CUSTOM, .parse = take_material, .context = o, .value = "NAME",
+         .help = "fit this wall material only (implies --stage wall)"},
+        {.name = "data", .kind = CAL_OPT_TEXT, .text = &o->data, .value = "DIR",
+         .help = "read DIR/repose_angle.csv and DIR/occupied_area.csv instead of the config's files (e.g. a twin "
+                 "made by granucal synthesize)"},
+        cal_option_out(&o->out, "results folder (default results/<config>-<tier>)"),
+        cal_option_jobs(&o->jobs),
+        cal_option_checkpoint_every(&o->checkpoint_every_s, "wall seconds between a drum run's checkpoints "
+                                                            "(default 120; 0: none)"),
+        cal_option_budget_hours(&o->budget_hours,
+                                "refuse, before the first simulation, a run whose EXPECTED wall time (the plan's, "
+                                "below) is over H hours; the worst case is printed beside it, not judged"),
+        cal_option_plan(&o->plan_only,
+                        "check every input, print the plan and stop: nothing runs, no folder is made. For each step "
+                        "and in all: simulations, core-hours and wall hours on --jobs workers, EXPECTED and (in "
+                        "parentheses) the worst case. Expected: each drum run ends at the steady test's first chance "
+                        "(two windows, then its averaging); COBYLA starts at the grid's best; the wall stages share "
+                        "one grid; a two-tier stage runs its max_evaluations; k_n is stage 1's choice where its "
+                        "cylinders are already in OUT/store, else the config's. Worst case: max_time, every "
+                        "evaluation, the stiffest k_n. Records already in OUT/store are not subtracted. "
+                        "tests/calibration/plan_vs_committed.sh holds the expected figures within 30 % of what the "
+                        "committed standard run (results/calibration-standard/) took."),
+    };
+    const cal_command_line line = {.command = "calibrate", .synopsis = synopsis, .epilogue = epilogue, .options = table,
+                                   .n_options = sizeof table / sizeof *table};
+    return cal_options_parse_config(&line, argc, argv, &o->config);
+}
+
+// ---- stage results kept between runs of single stages ---------------------------------
+
+typedef struct stage_file {
+    double k_n, mu_s, mu_r;
+    double mu_s_identified_min, mu_s_identified_max, mu_r_identified_min, mu_r_identified_max; ///< absent: 0
+    double mu_s_not_excluded_min, mu_s_not_excluded_max, mu_r_not_excluded_min, mu_r_not_excluded_max; ///< absent: 0
+} stage_file;
+#define STAGE_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, stage_file, member)
+static const cyaml_schema_field_t stage_fields[] = {
+    STAGE_FLOAT("k_n", k_n), STAGE_FLOAT("mu_s", mu_s), STAGE_FLOAT("mu_r", mu_r),
+    STAGE_FLOAT("mu_s_identified_min", mu_s_identified_min), STAGE_FLOAT("mu_s_identified_max", mu_s_identified_max),
+    STAGE_FLOAT("mu_r_identified_min", mu_r_identified_min), STAGE_FLOAT("mu_r_identified_max", mu_r_identified_max),
+    STAGE_FLOAT("mu_s_not_excluded_min", mu_s_not_excluded_min), STAGE_FLOAT("mu_s_not_excluded_max", mu_s_not_excluded_max),
+    STAGE_FLOAT("mu_r_not_excluded_min", mu_r_not_excluded_min), STAGE_FLOAT("mu_r_not_excluded_max", mu_r_not_excluded_max),
+    CYAML_FIELD_END};
+static const cyaml_schema_value_t stage_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, stage_file, stage_fields)};
+
+// ranges: the identified μs and μr ranges, or NULL (stage 1).
+static int write_stage(const char *dir, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2],
+                       char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    fprintf(a.f, "# written by granucal calibrate; read by later stages run alone\nk_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
+            k_n, mu_s, mu_r);
+    if (ranges && isfinite(ranges[1].lo))
+        fprintf(a.f, "mu_s_identified_min: %.17g\nmu_s_identified_max: %.17g\nmu_r_identified_min: %.17g\n"
+                     "mu_r_identified_max: %.17g\nmu_s_not_excluded_min: %.17g\nmu_s_not_excluded_max: %.17g\n"
+                     "mu_r_not_excluded_min: %.17g\nmu_r_not_excluded_max: %.17g\n",
+                ranges[0].lo, ranges[0].hi, ranges[1].lo, ranges[1].hi, ranges[0].bracket_lo, ranges[0].bracket_hi,
+                ranges[1].bracket_lo, ranges[1].bracket_hi);
+    return cal_atomic_commit(&a, err, len);
+}
+
+// The identified ranges a stage file kept (NAN if none: μr's range is never 0).
+static void stage_ranges(const stage_file *s, cal_range *mu_s, cal_range *mu_r)
+{
+    *mu_s = *mu_r = CAL_NO_RANGE;
+    if (!(s->mu_r_identified_min > 0)) return;
+    mu_s->lo = s->mu_s_identified_min, mu_s->hi = s->mu_s_identified_max;
+    mu_r->lo = s->mu_r_identified_min, mu_r->hi = s->mu_r_identified_max;
+    if (!(s->mu_r_not_excluded_min > 0)) return; // a stage file written before the bracket was kept
+    mu_s->bracket_lo = s->mu_s_not_excluded_min, mu_s->bracket_hi = s->mu_s_not_excluded_max;
+    mu_r->bracket_lo = s->mu_r_not_excluded_min, mu_r->bracket_hi = s->mu_r_not_excluded_max;
+}
+
+// 1 if the stage file exists and was read; -1 if it is damaged.
+static int read_stage(const char *dir, const char *name, stage_file *out, char *err, size_t len)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
+    if (access(path, F_OK) != 0) return 0;
+    stage_file *s = NULL;
+    if (exp_yaml_load(path, &stage_schema, (void **)&s, "delete it to rerun that stage", err, len)) return -1;
+    *out = *s;
+    exp_yaml_free(&stage_schema, s);
+    return 1;
+}
+
+// ---- checks before the first simulation ------------------------------------------------
+
+static int check_surface(const cal_series *angles, const cal_series *areas, const char *surface, char *err, size_t len)
+{
+    const cal_point *p[64];
+    if (cal_series_select(angles, surface, p, 64) == 0)
+        return exp_fail(err, len, "%s: no row for surface '%s' (the config names it)", angles->path, surface);
+    if (cal_series_select(areas, surface, p, 64) == 0)
+        return exp_fail(err, len, "%s: no row for surface '%s' (the config names it)", areas->path, surface);
+    return 0;
+}
+
+typedef struct run {
+    options opt;
+    cal_config *c;
+    const cal_tier *t;
+    cal_series angles, areas;
+    char out[1024];
+    cal_env env;
+    cal_stiffness_result stiffness;
+    cal_friction_result *granule, *walls[16];
+    int n_walls;
+    cal_table table;
+    cal_progress progress;
+    char err[2048];
+} run;
+
+static void plan_progress(run *r);
+static int check_predicted_cost(run *r);
+
+// Where a data file is read from: --data DIR's file of that name, else the config's.
+static void data_path(const run *r, const char *name, const char *configured, char *out, size_t len)
+{
+    if (r->opt.data) snprintf(out, len, "%s/%s", r->opt.data, name);
+    else cal_config_data_path(r->c, configured, out, len);
+}
+
+// A measured size table (gsd_table) is kept beside the config's copy under
+// its own name, which the copy then finds (a path relative to the config);
+// a table named with folders is not, and the run says so.
+static int keep_size_table(run *r)
+{
+    if (!r->c->gsd_table) return 0;
+    if (strchr(r->c->gsd_table, '/')) {
+        fprintf(stderr, "granucal calibrate: the size table '%s' is not kept in %s (its name has folders): a "
+                        "re-derivation from that folder needs it there\n", r->c->gsd_table, r->out);
+        return 0;
+    }
+    char from[1200], to[1200];
+    cal_config_data_path(r->c, r->c->gsd_table, from, sizeof from);
+    snprintf(to, sizeof to, "%s/%s", r->out, r->c->gsd_table);
+    return cal_copy_file(from, to, r->err, sizeof r->err);
+}
+
+// The inputs this run read, copied into its results folder (config.yaml,
+// repose_angle.csv, occupied_area.csv, a size table): its table can be re-derived from the
+// folder alone (tests/calibration/verify_committed.sh) whatever the shipped
+// config and data become.
+static int keep_inputs(run *r)
+{
+    char from[1200], to[1200];
+    snprintf(to, sizeof to, "%s/config.yaml", r->out);
+    if (cal_copy_file(r->c->path, to, r->err, sizeof r->err)) return 1;
+    const char *names[2] = {"repose_angle.csv", "occupied_area.csv"}, *configured[2] = {r->c->repose_angle, r->c->occupied_area};
+    for (int k = 0; k < 2; ++k) {
+        data_path(r, names[k], configured[k], from, sizeof from);
+        snprintf(to, sizeof to, "%s/%s", r->out, names[k]);
+        if (cal_copy_file(from, to, r->err, sizeof r->err)) return 1;
+    }
+    return keep_size_table(r);
+}
+
+// Everything checked, the plan predicted, then the results folder made: a
+// refused run leaves nothing behind.
+static int prepare(run *r)
+{
+    char path[1200];
+    r->c = cal_config_load(r->opt.config, r->opt.tier, r->err, sizeof r->err);
+    if (!r->c) return 1;
+    r->t = cal_config_tier(r->c);
+    data_path(r, "repose_angle.csv", r->c->repose_angle, path, sizeof path);
+    if (cal_series_load(&r->angles, path, CAL_DATA_ANGLE, r->err, sizeof r->err)) return 1;
+    data_path(r, "occupied_area.csv", r->c->occupied_area, path, sizeof path);
+    if (cal_series_load(&r->areas, path, CAL_DATA_CSA, r->err, sizeof r->err)) return 1;
+    if (check_surface(&r->angles, &r->areas, r->c->granule_surface, r->err, sizeof r->err)) return 1;
+    int found = r->opt.material == NULL;
+    for (unsigned k = 0; k < r->c->materials_count; ++k) {
+        if (check_surface(&r->angles, &r->areas, r->c->materials[k].surface, r->err, sizeof r->err)) return 1;
+        found |= r->opt.material && strcasecmp(r->opt.material, r->c->materials[k].name) == 0;
+    }
+    if (!found) return exp_fail(r->err, sizeof r->err, "--material '%s': not under materials in %s", r->opt.material, r->c->path);
+    r->env.workers = r->opt.jobs;
+    if (r->opt.out) snprintf(r->out, sizeof r->out, "%s", r->opt.out); // named, not made yet: the plan reads its store
+    else {
+        char stem[1024];
+        const char *base = strrchr(r->c->path, '/');
+        snprintf(stem, sizeof stem, "%s", base ? base + 1 : r->c->path);
+        stem[strcspn(stem, ".")] = '\0';
+        snprintf(r->out, sizeof r->out, "results/%.900s-%.60s", stem, r->t->name);
+    }
+    plan_progress(r);
+    if (check_predicted_cost(r)) return 1;
+    if (r->opt.plan_only) return 0; // the results folder is not made
+    if (cal_prepare_output(r->out, r->err, sizeof r->err)) return 1;
+    return cal_mpi_rank() == 0 ? keep_inputs(r) : 0;
+}
+
+static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }
+
+static int stage_stiffness(run *r, double *k_n, const char **source)
+{
+    *k_n = r->c->k_n, *source = "config k_n (stage 1 not run)";
+    if (wants(r, "stiffness")) {
+        unsigned n;
+        cal_tier_stiffness(r->c, r->t, &n);
+        int drum = cal_tier_stiffness_on_drum(r->t);
+        fprintf(stderr, "== stage 1: stiffness, %u candidates × %d seeds (%s λ = %g)\n", n, r->t->seeds,
+                drum ? "the drum's own bed," : "cylinder", drum ? r->t->lambda : r->t->cylinder_lambda);
+        if (cal_stage_stiffness(&r->env, r->c, r->t, &r->stiffness, r->err, sizeof r->err)) return 1;
+        if (!isfinite(r->stiffness.chosen_k))
+            return exp_fail(r->err, sizeof r->err, "stage 1: no candidate's CN is within the tolerance of the stiff limit");
+        if (!r->stiffness.resolved) {
+            fprintf(stderr, "stage 1: the CN of the softest candidate is within the noise of the stiff limit: the sweep "
+                            "does not resolve the stiffness at this tier; using the config's k_n = %g N/m\n", r->c->k_n);
+            *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
+            return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
+        }
+        *k_n = r->stiffness.chosen_k, r->table.k_calibrated = 1;
+        *source = drum ? "stage 1 (the drum's poured bed, Fig. 12)" : "stage 1 (poured cylinder, Fig. 12)";
+        return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
+    }
+    stage_file s;
+    int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
+    if (got < 0) return 1;
+    // An unresolved sweep stores the config's k_n too: only a k_n unlike the
+    // config's is known to be stage 1's choice.
+    if (got) *k_n = s.k_n, *source = "stage 1, earlier run (stage_stiffness.yaml)", r->table.k_calibrated = s.k_n != r->c->k_n;
+    return 0;
+}
+
+// Where a friction stage's pair came from: sources[0] if it matches the angle,
+// [1] if it is the best misfit of a tier that puts the angle in the misfit,
+// [2] if it is only the closest to the angle.
+static const char *friction_source(const cal_friction_result *f, const char *const sources[3])
+{
+    return f->best_feasible ? sources[0] : f->angle_in_misfit ? sources[1] : sources[2];
+}
+
+// One friction stage: across two tiers where the tier names a map tier.
+static int friction_stage(run *r, double k_n, const cal_material *m, double gg_mu_s, double gg_mu_r,
+                          cal_friction_result *out)
+{
+    if (!r->t->map_tier)
+        return cal_stage_friction(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, out, r->err,
+                                  sizeof r->err);
+    cal_friction_result *cheap = calloc(1, sizeof *cheap);
+    if (!cheap) return exp_fail(r->err, sizeof r->err, "out of memory");
+    int bad = cal_stage_two_tier(&r->env, r->c, r->t, &r->angles, &r->areas, k_n, m, gg_mu_s, gg_mu_r, out, cheap,
+                                 r->err, sizeof r->err);
+    free(cheap);
+    return bad;
+}
+
+static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const char **source)
+{
+    *mu_s = r->c->granule_mu_s, *mu_r = r->c->granule_mu_r, *source = "config granule_mu_s/mu_r (stage 2 not run)";
+    if (wants(r, "granule")) {
+        fprintf(stderr, "== stage 2: granule-granule friction (k_n = %g N/m, drum λ = %g)\n", k_n, r->t->lambda);
+        r->granule = calloc(1, sizeof *r->granule);
+        if (!r->granule) return exp_fail(r->err, sizeof r->err, "out of memory");
+        if (friction_stage(r, k_n, NULL, 0, 0, r->granule)) return 1;
+        const cal_candidate *b = &r->granule->cand[r->granule->best];
+        *mu_s = b->mu_s, *mu_r = b->mu_r;
+        r->table.gg_mu_s_range = r->granule->mu_s_range, r->table.gg_mu_r_range = r->granule->mu_r_range;
+        static const char *const sources[3] = {"stage 2 (drum lined with granules)",
+                                               "stage 2, best misfit (angle outside its tolerance)",
+                                               "stage 2, closest (angle not matched)"};
+        *source = friction_source(r->granule, sources);
+        r->table.gg_angle_matched = r->granule->cand[r->granule->best].angle_violation <= 0;
+        const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
+        return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
+    }
+    stage_file s;
+    int got = read_stage(r->out, "granule", &s, r->err, sizeof r->err);
+    if (got < 0) return 1;
+    if (got) {
+        *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
+        r->table.gg_angle_matched = -1;
+        stage_ranges(&s, &r->table.gg_mu_s_range, &r->table.gg_mu_r_range);
+    }
+    return 0;
+}
+
+static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
+{
+    if (!wants(r, "wall")) return 0;
+    for (unsigned k = 0; k < r->c->materials_count; ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if (r->opt.material && strcasecmp(r->opt.material, m->name) != 0) continue;
+        fprintf(stderr, "== stage 3: %s wall friction (granule-granule frozen at mu_s = %.4g, mu_r = %.4g)\n", m->name,
+                gg_mu_s, gg_mu_r);
+        cal_friction_result *w = r->walls[r->n_walls++] = calloc(1, sizeof *w);
+        if (!w) return exp_fail(r->err, sizeof r->err, "out of memory");
+        if (friction_stage(r, k_n, m, gg_mu_s, gg_mu_r, w)) return 1;
+        int t = r->table.n_walls++;
+        snprintf(r->table.wall_name[t], 32, "%s", m->name);
+        r->table.wall_mu_s[t] = w->cand[w->best].mu_s, r->table.wall_mu_r[t] = w->cand[w->best].mu_r;
+        r->table.wall_mu_s_range[t] = w->mu_s_range, r->table.wall_mu_r_range[t] = w->mu_r_range;
+        static const char *const sources[3] = {"stage 3 (drum lined with it)",
+                                               "stage 3, best misfit (angle outside its tolerance)",
+                                               "stage 3, closest (angle not matched)"};
+        snprintf(r->table.wall_source[t], 96, "%s", friction_source(w, sources));
+        r->table.wall_angle_matched[t] = w->cand[w->best].angle_violation <= 0;
+    }
+    return 0;
+}
+
+static void print_table(const char *dir)
+{
+    char path[1200], line[256];
+    snprintf(path, sizeof path, "%s/calibrated_parameters.md", dir);
+    FILE *f = fopen(path, "r");
+    while (f && fgets(line, sizeof line, f)) fputs(line, stdout);
+    if (f) fclose(f);
+    printf("\nresults: %s (report.md, calibrated_parameters.csv, plots)\n", dir);
+}
+
+// A friction stage's plan: with a map tier, the map's runs as a step of their
+// own ("NAME (map)", their own cost), then this tier's.
+static void plan_friction(run *r, const char *name, const cal_material *m)
+{
+    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
+    if (map) {
+        char label[64];
+        snprintf(label, sizeof label, "%.50s (map)", name);
+        cal_progress_plan(&r->progress, label, CAL_RUN_MAP_DRUM, cal_friction_planned_runs(r->c, map, &r->angles, &r->areas, m));
+    }
+    cal_progress_plan(&r->progress, name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
+}
+
+// ---- the plan: expected and worst-case cost, before the first simulation ----------------
+//
+// The expected figure assumes what the searches typically do (each also said
+// in the printed plan):
+//  - a drum run ends at the steady test's first chance, not at max_time
+//    (cal_plan_turn_time);
+//  - a one-tier search runs its grid, then COBYLA, whose first point is the
+//    grid's best (already run: max_evaluations - 1 new candidates after a
+//    grid), then the two bound probes;
+//  - the wall stages of one tier share their grid: the same pairs on the same
+//    bed (the granule pair frozen), run for the first material, found in the
+//    store by the others;
+//  - a two-tier stage runs all its max_evaluations at its own tier: it stops
+//    earlier only when a run agrees with the corrected map within the data's
+//    noise, or the map's optimum returns to a point already run, and with
+//    the standard tier's small noise that is the exception (the committed
+//    standard run stopped early in 1 of its 4 stages);
+//  - the friction stages run at the k_n stage 1 will give (plan_stiffness).
+// The worst case: every run turns max_time, every candidate a search may take
+// is new, and k_n is the stiffest stage 1 may choose. Both are the cost of the
+// whole calibration: records already in OUT/store are not subtracted.
+
+enum { PLAN_MAX_TIERS = 16, PLAN_MAX_STEPS = 2 * 16 + 3 }; // stage 1, granule and 16 walls, each with its map
+
+typedef struct plan_pass {
+    int worst;
+    double k_n;
+    int parallel;
+    int wall_grid_run[PLAN_MAX_TIERS]; ///< a wall stage of this tier ran its grid (expected figure)
+    int wall_bed_kept[PLAN_MAX_TIERS]; ///< a one-bed wall stage of this tier settled its bed
+} plan_pass;
+
+typedef struct plan {
+    char name[PLAN_MAX_STEPS][64], what[PLAN_MAX_STEPS][64];
+    cal_plan step[PLAN_MAX_STEPS];
+    int n;
+    cal_plan total;
+    double k_expected, k_worst;
+    char k_source[1400];
+} plan;
+
+static int tier_slot(const run *r, const cal_tier *t) { return (int)(t - r->c->tiers) % PLAN_MAX_TIERS; }
+
+// 1 if every cylinder of stage 1 is in OUT/store (read only: a plan changes nothing).
+static int cylinders_stored(const run *r, int *count)
+{
+    char store[1100], key[2048];
+    snprintf(store, sizeof store, "%s/store", r->out);
+    unsigned n;
+    const double *stiffness = cal_tier_stiffness(r->c, r->t, &n);
+    *count = 0;
+    for (unsigned k = 0; k < n; ++k)
+        for (int j = 0; j < r->t->seeds; ++j) {
+            cal_bed_case d = cal_bed_case_make(r->c, r->t, stiffness[k], (uint64_t)(r->c->seed + j));
+            cal_record rec;
+            char err[1024];
+            cal_bed_key(&d, key, sizeof key);
+            if (cal_store_get(store, key, &rec, err, sizeof err) != 0) return 0;
+            cal_record_free(&rec), ++*count;
+        }
+    return 1;
+}
+
+// The k_n the friction stages will run at, as far as it can be known before
+// the first simulation: stage 1's choice where all its cylinders are stored
+// (it then simulates nothing), the stage file of an earlier run where stage
+// 1 is not run, else the config's k_n; the worst case, the stiffest stage 1
+// may choose.
+static void plan_stiffness(run *r, plan *p)
+{
+    unsigned n;
+    const double *stiffness = cal_tier_stiffness(r->c, r->t, &n);
+    p->k_expected = p->k_worst = r->c->k_n;
+    snprintf(p->k_source, sizeof p->k_source, "the config's k_n");
+    int stored;
+    if (wants(r, "stiffness") && cylinders_stored(r, &stored)) {
+        cal_env env = {.workers = 1};
+        snprintf(env.store, sizeof env.store, "%s/store", r->out);
+        cal_stiffness_result *s = calloc(1, sizeof *s);
+        if (s && !cal_stage_stiffness(&env, r->c, r->t, s, r->err, sizeof r->err) && s->resolved) {
+            p->k_expected = p->k_worst = s->chosen_k;
+            snprintf(p->k_source, sizeof p->k_source, "stage 1's choice from its %d cylinders already in %s/store", stored,
+                     r->out);
+        } else if (s)
+            snprintf(p->k_source, sizeof p->k_source, "the config's k_n: stage 1 does not resolve it from its %d stored "
+                     "cylinders", stored);
+        free(s);
+        return;
+    }
+    if (wants(r, "stiffness")) {
+        p->k_worst = fmax(r->c->k_n, stiffness[n - 1]);
+        snprintf(p->k_source, sizeof p->k_source, "the config's k_n until stage 1 has chosen (worst case: its stiffest "
+                 "candidate, %g N/m)", stiffness[n - 1]);
+        return;
+    }
+    stage_file sf;
+    char err[512];
+    if (read_stage(r->out, "stiffness", &sf, err, sizeof err) == 1 && sf.k_n > 0) {
+        p->k_expected = p->k_worst = sf.k_n;
+        snprintf(p->k_source, sizeof p->k_source, "stage 1 of an earlier run (%s/stage_stiffness.yaml)", r->out);
+    }
+}
+
+// Stage 1's poured cylinders: one batch, a task per candidate and seed, the stiffer dearer (a smaller step).
+static void plan_cylinders(const run *r, int parallel, cal_plan_cost *cost)
+{
+    unsigned n;
+    const double *stiffness = cal_tier_stiffness(r->c, r->t, &n);
+    int m = 0, all = (int)n * r->t->seeds;
+    double *task = calloc((size_t)all, sizeof *task);
+    if (!task) return;
+    for (unsigned k = 0; k < n; ++k)
+        for (int j = 0; j < r->t->seeds; ++j) {
+            cal_bed_case d = cal_bed_case_make(r->c, r->t, stiffness[k], (uint64_t)(r->c->seed + j));
+            double memory_mb = 0, steps = cal_bed_predict_particle_steps(&d, &memory_mb);
+            task[m++] = steps / CAL_PLAN_RATE;
+            cost->core_s += steps / CAL_PLAN_RATE, cost->memory_mb = fmax(cost->memory_mb, memory_mb);
+        }
+    cost->runs += m;
+    cost->wall_s += cal_plan_makespan(task, m, parallel);
+    free(task);
+}
+
+// One batch of m candidates of a friction stage at tier t.
+static void plan_batch(const run *r, plan_pass *pass, const cal_tier *t, const cal_material *m, const double *rpm,
+                       int speeds, int candidates, cal_plan_cost *cost)
+{
+    if (candidates <= 0) return;
+    cal_drum_case d = cal_drum_case_granule(r->c, t, pass->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
+    int beds = cal_tier_beds(t), *kept = &pass->wall_bed_kept[tier_slot(r, t)];
+    cal_plan_drum_batch(cost, &d, rpm, speeds, candidates, beds, m != NULL, m && *kept, pass->parallel, pass->worst);
+    if (m && beds == 1) *kept = 1;
+}
+
+// A friction stage at tier t by itself: a one-tier search, or (deciding) the
+// runs of a two-tier stage at its own tier, one candidate at a time.
+static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const cal_material *m, int deciding,
+                       cal_plan_cost *cost, char *err, size_t len)
+{
+    double rpm[CAL_MAX_RPM];
+    int speeds = cal_friction_speeds(r->c, t, &r->angles, &r->areas, m, rpm, NULL, err, len);
+    if (speeds < 1) return 1;
+    if (deciding) {
+        for (int i = 0; i < t->max_evaluations; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
+        return 0;
+    }
+    int *grid_run = &pass->wall_grid_run[tier_slot(r, t)];
+    if (pass->worst || !m || !*grid_run) plan_batch(r, pass, t, m, rpm, speeds, t->grid * t->grid, cost);
+    if (m && t->grid > 0) *grid_run = 1;
+    int cobyla = t->max_evaluations - (!pass->worst && t->grid > 0 && t->max_evaluations > 0);
+    for (int i = 0; i < cobyla; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
+    if (cal_tier_bound_probes(t)) plan_batch(r, pass, t, m, rpm, speeds, 2, cost);
+    return 0;
+}
+
+// A step of the plan: its name and what it runs, expected and worst (w = 0, 1).
+static cal_plan *plan_step(plan *p, const char *name, const char *what)
+{
+    if (p->n == PLAN_MAX_STEPS) return &p->step[p->n - 1]; // more materials than the config allows: never
+    snprintf(p->name[p->n], sizeof p->name[0], "%s", name);
+    snprintf(p->what[p->n], sizeof p->what[0], "%s", what);
+    return &p->step[p->n++];
+}
+
+// A friction stage's steps: with a map tier, the map's whole search ("NAME
+// (map)") then this tier's runs; else this tier's search.
+static int plan_friction_steps(run *r, plan *p, plan_pass pass[2], const cal_material *m, const char *name)
+{
+    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
+    char label[64], what[64];
+    for (int step = map ? 0 : 1; step < 2; ++step) {
+        const cal_tier *t = step ? r->t : map;
+        snprintf(label, sizeof label, step ? "%.50s" : "%.50s (map)", name);
+        snprintf(what, sizeof what, "drum runs at tier '%.31s'", t->name);
+        cal_plan *c = plan_step(p, label, what);
+        for (int w = 0; w < 2; ++w)
+            if (plan_search(r, &pass[w], t, m, step && map, w ? &c->worst : &c->expected, r->err, sizeof r->err)) return 1;
+    }
+    return 0;
+}
+
+// Every step of the calibration (as plan_progress), its expected and worst cost.
+static int plan_cost(run *r, plan *p)
+{
+    int parallel = r->env.workers * cal_mpi_size();
+    plan_pass pass[2] = {{.worst = 0, .k_n = p->k_expected, .parallel = parallel},
+                         {.worst = 1, .k_n = p->k_worst, .parallel = parallel}};
+    if (wants(r, "stiffness")) {
+        cal_plan *c = plan_step(p, "stiffness", "poured cylinders");
+        plan_cylinders(r, parallel, &c->expected), plan_cylinders(r, parallel, &c->worst);
+    }
+    if (wants(r, "granule") && plan_friction_steps(r, p, pass, NULL, "granule")) return 1;
+    for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if ((!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) && plan_friction_steps(r, p, pass, m, m->name))
+            return 1;
+    }
+    for (int k = 0; k < p->n; ++k) cal_plan_add(&p->total, &p->step[k]);
+    return 0;
+}
+
+static void print_plan(const run *r, const plan *p)
+{
+    int parallel = r->env.workers * cal_mpi_size();
+    fprintf(stderr, "== plan: tier '%s', %d worker(s); expected (worst case)\n", r->t->name, parallel);
+    for (int k = 0; k < p->n; ++k) {
+        const cal_plan *c = &p->step[k];
+        fprintf(stderr, "   %-18s %4d (%4d) %-28s %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", p->name[k], c->expected.runs,
+                c->worst.runs, p->what[k], c->expected.core_s / 3600, c->worst.core_s / 3600, c->expected.wall_s / 3600,
+                c->worst.wall_s / 3600);
+    }
+    char e[128], w[128];
+    cal_plan_describe(&p->total.expected, parallel, e, sizeof e), cal_plan_describe(&p->total.worst, parallel, w, sizeof w);
+    fprintf(stderr, "== plan: expected %d simulations, %s; worst case %d simulations, %s; %.0f MB a simulation\n",
+            p->total.expected.runs, e, p->total.worst.runs, w, fmax(p->total.expected.memory_mb, p->total.worst.memory_mb));
+    fprintf(stderr, "   expected: each drum run ends at the steady test's first chance (two windows, then its averaging), "
+                    "a search's COBYLA starts at the grid's best (run already), the wall stages share one grid, a "
+                    "two-tier stage runs all its max_evaluations; k_n %g N/m, %s. Worst case: max_time every run, every "
+                    "candidate new, k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
+                    "records already in %s/store are not subtracted.\n",
+            p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
+}
+
+// The plan printed; refused if one simulation per worker cannot fit the
+// memory free, or if the EXPECTED wall time is over --budget-hours.
+static int check_predicted_cost(run *r)
+{
+    plan *p = calloc(1, sizeof *p);
+    if (!p) return exp_fail(r->err, sizeof r->err, "out of memory");
+    plan_stiffness(r, p);
+    if (plan_cost(r, p)) return free(p), 1;
+    print_plan(r, p);
+    int parallel = r->env.workers * cal_mpi_size();
+    double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);
+    char e[128], w[128];
+    cal_plan_describe(&p->total.expected, parallel, e, sizeof e), cal_plan_describe(&p->total.worst, parallel, w, sizeof w);
+    double expected_h = p->total.expected.wall_s / 3600;
+    free(p);
+    long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    double free_mb = pages > 0 && page > 0 ? (double)pages * (double)page / 1048576 : INFINITY;
+    if (memory_mb * r->env.workers > free_mb)
+        return exp_fail(r->err, sizeof r->err, "tier '%s': %.0f MB a simulation; %d at once need more than the %.0f MB "
+                        "free: use fewer --jobs or a coarser tier", r->t->name, memory_mb, r->env.workers, free_mb);
+    if (expected_h > r->opt.budget_hours)
+        return exp_fail(r->err, sizeof r->err, "tier '%s': expected %s (worst case %s), over --budget-hours %g, which "
+                        "judges the expected figure: nothing was run", r->t->name, e, w, r->opt.budget_hours);
+    return 0;
+}
+
+// Every stage this run will do, with the simulations it may take, so that
+// progress lines can say how far the whole calibration is and the time left.
+static void plan_progress(run *r)
+{
+    cal_progress *p = &r->progress;
+    cal_progress_init(p, r->env.workers * cal_mpi_size());
+    unsigned n_k;
+    cal_tier_stiffness(r->c, r->t, &n_k);
+    if (wants(r, "stiffness")) cal_progress_plan(p, "stiffness", CAL_RUN_CYLINDER, (int)n_k * r->t->seeds);
+    if (wants(r, "granule")) plan_friction(r, "granule", NULL);
+    for (unsigned k = 0; k < r->c->materials_count && wants(r, "wall"); ++k) {
+        const cal_material *m = &r->c->materials[k];
+        if (!r->opt.material || strcasecmp(r->opt.material, m->name) == 0) plan_friction(r, m->name, m);
+    }
+    r->env.progress = p;
+}
+
+static int calibrate(run *r, const char *command)
+{
+    double k_n, gg_mu_s, gg_mu_r;
+    const char *k_source, *gg_source;
+    r->env.started = exp_wall_seconds();
+    r->table.gg_mu_s_range = r->table.gg_mu_r_range = CAL_NO_RANGE; // until stage 2 says
+    if (stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &gg_mu_s, &gg_mu_r, &gg_source) ||
+        stage_walls(r, k_n, gg_mu_s, gg_mu_r))
+        return 1;
+    r->table.density = r->c->density, r->table.xi = r->c->xi, r->table.k_n = k_n, r->table.k_source = k_source;
+    r->table.gg_mu_s = gg_mu_s, r->table.gg_mu_r = gg_mu_r, r->table.gg_source = gg_source;
+    if (cal_mpi_rank() != 0) return 0;
+    cal_outcome o = {.config = r->c, .tier = r->t, .stiffness = wants(r, "stiffness") ? &r->stiffness : NULL,
+                     .granule = r->granule, .n_walls = r->n_walls, .table = r->table, .command = command,
+                     .angle_data_synthetic = r->angles.synthetic, .csa_data_synthetic = r->areas.synthetic,
+                     .wall_time_s = exp_wall_seconds() - r->env.started, .ranks = cal_mpi_size(), .workers = r->env.workers};
+    for (int w = 0; w < r->n_walls; ++w) o.walls[w] = r->walls[w];
+    if (cal_report_write(r->out, &o, r->err, sizeof r->err)) return 1;
+    print_table(r->out);
+    fprintf(stderr, "granucal calibrate: done in %.0f s; %llu simulations run now, the rest from the store\n",
+            o.wall_time_s, r->env.simulations_run);
+    return 0;
+}
+
+int cal_cmd_calibrate(int argc, char **argv)
+{
+    run *r = calloc(1, sizeof *r);
+    if (!r) return fputs("granucal calibrate: out of memory\n", stderr), 1;
+    int status = parse_options(argc, argv, &r->opt);
+    if (status) return free(r), status < 0 ? 0 : status;
+    char command[2048] = "granucal";
+    for (int k = 0; k < argc; ++k)
+        snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
+    cal_mpi_init(&argc, &argv);
+#ifdef _OPENMP
+    // Parallelism is across simulations (processes, ranks); each simulation
+    // runs on one thread, which also keeps forked children clear of the
+    // OpenMP runtime's threads.
+    omp_set_num_threads(1);
+#endif
+    status = prepare(r);
+    if (!status && r->opt.plan_only) fputs("granucal calibrate: --plan: every input checked, nothing was run\n", stderr);
+    else if (!status) {
+        snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
+        r->env.use_fork = cal_mpi_size() == 1, r->env.tty = isatty(2); // workers: set by prepare, for the plan
+        r->env.checkpoint_every_s = r->opt.checkpoint_every_s;
+        status = calibrate(r, command);
+    }
+    if (status) fprintf(stderr, "granucal calibrate: %s\n", r->err);
+    status = cal_mpi_any(status);
+    cal_sim_release(&r->env); // the bed kept between candidates
+    cal_series_free(&r->angles), cal_series_free(&r->areas);
+    free(r->granule);
+    for (int w = 0; w < r->n_walls; ++w) free(r->walls[w]);
+    if (r->c) cal_config_free(r->c);
+    free(r);
+    cal_mpi_finalize();
+    return status ? 1 : 0;
+}

@@ -1,0 +1,276 @@
+// SPDX-License-Identifier: MIT
+// `granucal simulate FILE.yaml`: the one home of its runners. An experiment
+// config (drum, compression, silo, cylinder) goes to its runner through
+// simulate_runners; anything else is an explicit scene, run here and written
+// out frame by frame.
+#include <libgen.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cal_commands.h"
+#include "cal_options.h"
+#include "cal_case_runs.h"
+#include "cal_files.h"
+#include "exp_common.h"
+#include "dem_output.h"
+#include "exp_compress.h"
+#include "exp_cylinder_config.h"
+#include "exp_cylinder_runner.h"
+#include "exp_drum_config.h"
+#include "exp_scene.h"
+#include "exp_silo.h"
+
+static const char simulate_synopsis[] =
+    "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"
+    "                         [--checkpoint-every S]\n"
+    "\n"
+    "A drum experiment (a file that starts `experiment: drum`, e.g. configs/drum.yaml):\n"
+    "fills the drum by bed volume, turns the settled bed rigidly by start_tilt_deg\n"
+    "(20; a drum turns a level bed that far before it first avalanches), turns the\n"
+    "drum until the angle and the occupied area are statistically steady (or\n"
+    "max_time), and prints one JSON object with angle_deg,\n"
+    "csa_percent, their spreads, steady, simulated_time_s, wall_time_s, granules and\n"
+    "particle_steps; DIR (default results/runs/drum) gets result.json and result.h5.\n"
+    "--set overrides a field: rpm, mu_s, mu_r, k_n, xi, wall (granules or a material),\n"
+    "lambda, seed, fill, slice_depth, max_time, start_tilt_deg. --rpm-list\n"
+    "4,40,80,105,116 turns one settled bed at each speed (results in\n"
+    "DIR/rpm_<speed>/, one JSON with \"runs\"). Each turn saves its state to\n"
+    "DIR[/rpm_<speed>]/checkpoint.h5 every --checkpoint-every S of wall time (default\n"
+    "120, 0: never); the same command after a kill resumes the turn there (the bed is\n"
+    "settled again) and ends as the uninterrupted run would, bit for bit.\n"
+    "Examples:\n"
+    "  granucal simulate configs/drum.yaml --set rpm=40 --set wall=PTFE\n"
+    "  granucal simulate configs/drum.yaml --rpm-list 4,40,80,105,116\n"
+    "\n"
+    "The poured cylinder (`experiment: cylinder`, configs/cylinder.yaml; section 4.1):\n"
+    "pours into the 100 x 40 mm container, strikes off at the rim, settles, and prints\n"
+    "one JSON object with granules, coordination (granule-granule contacts per\n"
+    "granule), coordination_interior, wall_contacts_per_granule, solid_fraction,\n"
+    "simulated_time_s, wall_time_s and dt_s; DIR (default results/runs/cylinder) gets\n"
+    "result.json and result.h5. --set overrides k_n, mu_s, mu_r, xi, lambda, seed,\n"
+    "diameter, depth, density. Example:\n"
+    "  granucal simulate configs/cylinder.yaml --set k_n=800 --set seed=2\n"
+    "\n"
+    "The confined compression test (configs/compression.yaml) and the silo discharge\n"
+    "(configs/silo.yaml) take --set and --out the same way (see those files).\n";
+
+static const char simulate_epilogue[] =
+    "An explicit scene (granules and walls listed one by one) writes, in DIR\n"
+    "(default results/runs/<scene name>):\n"
+    "  trajectory.csv  every granule every output_interval, columns\n"
+    "                  t,id,x,y,z,vx,vy,vz,wx,wy,wz (SI units; id = the granule's\n"
+    "                  1-based position in the scene file)\n"
+    "  result.h5       the same frames with diagnostics (contacts, coordination\n"
+    "                  number, kinetic energy, overlap), plus result.xmf for ParaView\n"
+    "  result.json     the summary printed on stdout\n"
+    "\n"
+    "The time step is the scene's `dt`, checked against the engine's stability\n"
+    "limit (a step above it is refused), or, when `dt` is 0 or absent, chosen by\n"
+    "the engine; the choice and the reason are printed on stderr.\n"
+    "\n"
+    "Example (the paper's verification test, Appendix A.1):\n"
+    "  granucal simulate configs/scenes/verification_two_particles.yaml\n";
+
+typedef struct sim_outputs {
+    cal_atomic_file csv;
+    dem_h5_writer *h5;
+} sim_outputs;
+
+static void write_rows(FILE *f, const dem_world *w)
+{
+    dem_granules_view g = dem_world_granules(w);
+    double t = dem_world_time(w);
+    for (size_t i = 0; i < g.count; ++i)
+        fprintf(f, "%.10g,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t,
+                (unsigned long long)g.id[i] + 1, g.position[i].x, g.position[i].y, g.position[i].z, g.velocity[i].x,
+                g.velocity[i].y, g.velocity[i].z, g.omega[i].x, g.omega[i].y, g.omega[i].z);
+}
+
+static int write_frame(sim_outputs *o, const dem_world *w)
+{
+    write_rows(o->csv.f, w);
+    dem_granules_view g = dem_world_granules(w);
+    dem_diagnostics d = dem_world_diagnose(w);
+    return dem_h5_write_frame(o->h5, dem_world_time(w), &g, &d);
+}
+
+static int open_outputs(sim_outputs *o, const char *dir, char *err, size_t len)
+{
+    char path[1100];
+    if (cal_mkdirs(dir, err, len)) return 1;
+    snprintf(path, sizeof path, "%s/trajectory.csv", dir);
+    if (cal_atomic_open(&o->csv, path, err, len)) return 1;
+    fprintf(o->csv.f, "t,id,x,y,z,vx,vy,vz,wx,wy,wz\n");
+    snprintf(path, sizeof path, "%s/result.h5", dir);
+    o->h5 = dem_h5_open(path, err, len);
+    if (!o->h5) {
+        cal_atomic_abort(&o->csv);
+        return 1;
+    }
+    return 0;
+}
+
+// Run the scene, one frame per output interval; returns the engine status.
+static dem_status run_scene(const exp_scene *s, dem_world *w, sim_outputs *o, uint64_t *steps_done)
+{
+    double dt = dem_world_dt(w);
+    uint64_t per_frame = (uint64_t)(s->output_interval / dt + 0.5);
+    if (per_frame == 0) per_frame = 1;
+    uint64_t total = (uint64_t)(s->duration / dt + 0.5);
+    dem_status st = DEM_OK;
+    if (write_frame(o, w)) return DEM_ERR_INVALID;
+    for (*steps_done = 0; *steps_done < total && st == DEM_OK;) {
+        uint64_t n = total - *steps_done < per_frame ? total - *steps_done : per_frame;
+        st = dem_world_step(w, n);
+        *steps_done += n;
+        if (write_frame(o, w)) return DEM_ERR_INVALID;
+    }
+    return st;
+}
+
+static void summary_json(FILE *f, const exp_scene *s, const dem_world *w, dem_status st, uint64_t steps, double wall)
+{
+    char features[1024];
+    dem_world_describe_features(w, features, sizeof features);
+    dem_diagnostics d = dem_world_diagnose(w);
+    fprintf(f,
+            "{\"scene\": \"%s\", \"status\": \"%s\", \"granules\": %zu, \"dt_s\": %.6g, \"steps\": %llu, "
+            "\"simulated_time_s\": %.6g, \"wall_time_s\": %.3f, \"particle_steps\": %llu, "
+            "\"contacts\": %zu, \"wall_contacts\": %zu, \"ke_translational_J\": %.6g, \"ke_rotational_J\": %.6g, "
+            "\"effects\": \"%s\"",
+            s->name, st == DEM_OK ? "ok" : "failed", d.granules, dem_world_dt(w), (unsigned long long)steps,
+            dem_world_time(w), wall, (unsigned long long)(steps * d.granules), d.contacts, d.wall_contacts,
+            d.ke_translational, d.ke_rotational, features);
+    if (st != DEM_OK) fprintf(f, ", \"error\": \"%s\"", dem_world_error(w));
+    fprintf(f, "}\n");
+}
+
+static int finish(const char *dir, sim_outputs *o, const exp_scene *s, dem_world *w, dem_status st, uint64_t steps,
+                  double wall)
+{
+    char err[1024], path[1100];
+    int bad = cal_atomic_commit(&o->csv, err, sizeof err);
+    bad = bad || dem_h5_close(o->h5, err, sizeof err);
+    cal_atomic_file json;
+    snprintf(path, sizeof path, "%s/result.json", dir);
+    if (!bad && !cal_atomic_open(&json, path, err, sizeof err)) {
+        summary_json(json.f, s, w, st, steps, wall);
+        bad = cal_atomic_commit(&json, err, sizeof err);
+    }
+    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
+    summary_json(stdout, s, w, st, steps, wall);
+    if (st != DEM_OK) fprintf(stderr, "granucal simulate: run failed: %s\n", dem_world_error(w));
+    return bad || st != DEM_OK ? 1 : 0;
+}
+
+// What `granucal simulate` hands every runner: the options as given.
+typedef struct simulate_args {
+    int n_sets;
+    char **sets;     // --set KEY=VALUE overrides
+    const char *out; // --out DIR, or NULL for the runner's default
+    const char *rpm_list;
+    double checkpoint_every_s;
+} simulate_args;
+
+// The plain scene (granules and walls listed one by one): the runner when no
+// experiment claims the file.
+static int run_scene_file(const char *path, const simulate_args *a)
+{
+    if (a->n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
+    char err[1024], dir[1024];
+    exp_scene *s = exp_scene_load(path, err, sizeof err);
+    if (!s) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    snprintf(dir, sizeof dir, "%s", a->out ? a->out : "");
+    if (!a->out) snprintf(dir, sizeof dir, "results/runs/%s", s->name);
+    dem_world *w = exp_scene_build(s, err, sizeof err);
+    if (!w) return fprintf(stderr, "granucal simulate: %s: %s\n", path, err), exp_scene_free(s), 1;
+    int rc = 1;
+    sim_outputs o = {0};
+    if (dem_world_prepare(w) != DEM_OK) {
+        fprintf(stderr, "granucal simulate: %s: %s\n", path, dem_world_error(w));
+    } else if (open_outputs(&o, dir, err, sizeof err)) {
+        fprintf(stderr, "granucal simulate: %s\n", err);
+    } else {
+        fprintf(stderr, "granucal simulate: %s\n", dem_world_dt_report(w));
+        double t0 = exp_wall_seconds();
+        uint64_t steps = 0;
+        dem_status st = run_scene(s, w, &o, &steps);
+        rc = finish(dir, &o, s, w, st, steps, exp_wall_seconds() - t0);
+    }
+    dem_world_destroy(w);
+    exp_scene_free(s);
+    return rc;
+}
+
+// The experiments' runners, one per experiment: each loads its config into
+// definitions (exp_NAME_load) and hands them to the experiment's runner. The
+// drum's runner is calib's own (cal_simulate_drum.c: its checkpoints are
+// keyed like the calibration's store, and it takes --rpm-list and
+// --checkpoint-every); the others live with their experiment
+// (experiments/NAME/), which knows nothing of calib. Compression and the silo
+// still load their config in their runner (one file each, not yet split).
+static int run_drum(const char *path, const simulate_args *a)
+{
+    char err[1024];
+    exp_drum_yaml *y = exp_drum_config_load(path, a->n_sets, a->sets, err, sizeof err);
+    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    int rc = cal_simulate_drum(y, a->out, a->rpm_list, a->checkpoint_every_s);
+    exp_drum_config_free(y);
+    return rc;
+}
+static int run_compress(const char *path, const simulate_args *a)
+{
+    return exp_compress_simulate(path, a->n_sets, a->sets, a->out);
+}
+static int run_silo(const char *path, const simulate_args *a) { return exp_silo_simulate(path, a->n_sets, a->sets, a->out); }
+static int run_cylinder(const char *path, const simulate_args *a)
+{
+    char err[1400];
+    exp_cylinder_def d;
+    if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err))
+        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    return exp_cylinder_simulate(&d, a->out);
+}
+
+// Every experiment `granucal simulate` runs: the first whose `claims` knows
+// the file (its first key, `experiment: NAME`) runs it; a file none claims
+// is a plain scene.
+static const struct simulate_runner {
+    int (*claims)(const char *path);
+    int (*run)(const char *path, const simulate_args *a);
+} simulate_runners[] = {
+    {exp_is_drum_config, run_drum},
+    {exp_is_compress_config, run_compress},
+    {exp_is_silo_config, run_silo},
+    {exp_is_cylinder_config, run_cylinder},
+};
+
+enum { MAX_SETS = 64 };
+
+int cal_cmd_simulate(int argc, char **argv)
+{
+    char *sets[MAX_SETS];
+    simulate_args a = {.sets = sets, .checkpoint_every_s = CAL_CHECKPOINT_EVERY_S};
+    cal_option out = cal_option_out(&a.out, "results folder (default results/runs/<experiment or scene name>)");
+    out.short_name = 'o'; // -o has always been taken here
+    const cal_option table[] = {
+        {.name = "set", .short_name = 's', .kind = CAL_OPT_LIST, .list = sets, .count = &a.n_sets, .max = MAX_SETS,
+         .value = "KEY=VALUE", .help = "override a field of an experiment config (repeatable; the keys: above)"},
+        {.name = "rpm-list", .kind = CAL_OPT_TEXT, .text = &a.rpm_list, .value = "LIST",
+         .help = "a drum: turn one settled bed at each speed of LIST (4,40,80)"},
+        out,
+        cal_option_checkpoint_every(&a.checkpoint_every_s, "a drum: wall seconds between a turn's checkpoints "
+                                                           "(default 120; 0: none)"),
+    };
+    const cal_command_line line = {.command = "simulate", .synopsis = simulate_synopsis, .epilogue = simulate_epilogue,
+                                   .options = table, .n_options = sizeof table / sizeof *table,
+                                   .operand = "SCENE.yaml", .min_operands = 1, .max_operands = 1};
+    char **operands;
+    int n_operands, status = cal_options_parse(&line, argc, argv, &operands, &n_operands);
+    if (status) return status < 0 ? 0 : status;
+    const char *path = operands[0];
+    for (size_t k = 0; k < sizeof simulate_runners / sizeof *simulate_runners; ++k)
+        if (simulate_runners[k].claims(path)) return simulate_runners[k].run(path, &a);
+    return run_scene_file(path, &a);
+}

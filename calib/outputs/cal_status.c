@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+// What a calibration's outputs are, and what each value in them is (see cal_status.h).
+#include "cal_status.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "cal_files.h"
+#include "exp_common.h"
+#include "exp_contact_rules.h"
+
+// ---- one value -------------------------------------------------------------------
+
+static void add_flag(cal_verdict *v, const char *flag)
+{
+    size_t used = strlen(v->flags);
+    snprintf(v->flags + used, sizeof v->flags - used, "%s%s", used ? ";" : "", flag);
+}
+
+// A value on a bound, relative to the bound's size (μr's bounds span decades).
+static int on_bound(double value, double bound) { return fabs(value - bound) <= 1e-9 * fabs(bound); }
+
+static int outside(double value, double lo, double hi)
+{
+    // The ranges are written to 6 significant digits and read back the
+    // same way from a stage file: a value at an end must not fall out of it.
+    const double slack = 1e-6;
+    return value < lo * (1 - slack) || value > hi * (1 + slack);
+}
+
+cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched)
+{
+    cal_verdict v = {.status = CAL_VALUE_CALIBRATED};
+    if (!isfinite(g.lo)) {
+        v.status = CAL_VALUE_NOT_RUN;
+        add_flag(&v, "stage_not_run");
+        return v;
+    }
+    if (on_bound(value, bound_lo)) add_flag(&v, "at_lower_bound"), v.side = -1;
+    if (on_bound(value, bound_hi)) add_flag(&v, "at_upper_bound"), v.side = +1;
+    int out_identified = outside(value, g.lo, g.hi);
+    int out_bracket = isfinite(g.bracket_lo) && outside(value, g.bracket_lo, g.bracket_hi);
+    if (out_identified) add_flag(&v, "outside_identified");
+    if (out_bracket) add_flag(&v, "outside_not_excluded");
+    // Nothing excluded on either side: every value of the search range fits.
+    int none_excluded = isfinite(g.bracket_lo) && on_bound(g.bracket_lo, bound_lo) && on_bound(g.bracket_hi, bound_hi);
+    if (none_excluded) add_flag(&v, "not_identified");
+    if (angle_matched == 0) add_flag(&v, "angle_not_matched");
+    // The strongest verdict wins: a value outside its own interval is no
+    // result at all; one the data do not constrain is not identified; a
+    // bound the data do not close gives one side only.
+    if (out_identified || out_bracket) v.status = CAL_VALUE_NOT_A_RESULT, v.side = 0;
+    else if (none_excluded) v.status = CAL_VALUE_NOT_IDENTIFIED, v.side = 0;
+    else if (v.side) {
+        // On the upper bound the data say only that μ is above the nearest
+        // excluded value below (and the mirror on the lower bound).
+        v.status = CAL_VALUE_ONE_SIDED;
+        double other = v.side > 0 ? g.bracket_lo : g.bracket_hi;
+        v.known = isfinite(other) ? other : value;
+    }
+    return v;
+}
+
+const char *cal_value_status_name(cal_value_status s)
+{
+    static const char *const names[] = {"input", "derived", "calibrated", "one-sided", "not identified", "not a result",
+                                        "stage not run"};
+    return names[s];
+}
+
+const char *cal_verdict_value_text(char *out, size_t len, double value, const cal_verdict *v)
+{
+    switch (v->status) {
+    case CAL_VALUE_ONE_SIDED: snprintf(out, len, "%s %.3g", v->side > 0 ? "≥" : "≤", v->known); break;
+    case CAL_VALUE_NOT_IDENTIFIED: snprintf(out, len, "not identified"); break;
+    case CAL_VALUE_NOT_A_RESULT: snprintf(out, len, "not a result"); break;
+    default: snprintf(out, len, "%.4g", value);
+    }
+    return out;
+}
+
+// ---- the table ---------------------------------------------------------------------
+
+static const cal_range no_range = CAL_NO_RANGE_INIT;
+
+static cal_table_row plain_row(const char *contact, const char *parameter, double value, const char *unit,
+                               cal_value_status status)
+{
+    return (cal_table_row){contact, "", parameter, value, unit, no_range, {.status = status}};
+}
+
+static cal_table_row friction_row(const char *contact, const char *material, const char *parameter, double value,
+                                  cal_range g, double bound_lo, double bound_hi, int angle_matched)
+{
+    cal_table_row r = {contact, "", parameter, value, "-", g,
+                       cal_verdict_friction(value, g, bound_lo, bound_hi, angle_matched)};
+    snprintf(r.material, sizeof r.material, "%s", material);
+    return r;
+}
+
+// The stiffness rows: stage 1's choice, or the config's where it did not choose.
+static cal_table_row stiffness_row(const cal_outcome *o, const char *contact, const char *parameter, double k)
+{
+    const cal_table *t = &o->table;
+    int own = strcmp(contact, "granule-granule") == 0 && strcmp(parameter, "k_n") == 0;
+    cal_table_row r = plain_row(contact, parameter, k, "N/m", own ? CAL_VALUE_CALIBRATED : CAL_VALUE_DERIVED);
+    if (!t->k_calibrated) {
+        if (own) r.verdict.status = CAL_VALUE_NOT_RUN;
+        add_flag(&r.verdict, "stage_not_run");
+    } else if (!cal_tier_stiffness_on_drum(o->tier) && o->tier->cylinder_lambda != o->tier->lambda)
+        add_flag(&r.verdict, "stiffness_at_cylinder_lambda"); // a drum-bed sweep ran at the drum's own λ
+    return r;
+}
+
+int cal_table_rows(const cal_outcome *o, cal_table_row *rows)
+{
+    const cal_table *t = &o->table;
+    const cal_bounds *gb = &o->config->granule, *wb = &o->config->wall;
+    const char *gg = "granule-granule", *gw = "granule-boundary", *k_names[] = {"k_n", "k_s", "k_r"};
+    int n = 0;
+    rows[n++] = plain_row(gg, "density", t->density, "kg/m3", CAL_VALUE_INPUT);
+    for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gg, k_names[k], t->k_n);
+    rows[n++] = plain_row(gg, "xi", t->xi, "-", CAL_VALUE_INPUT);
+    rows[n++] = friction_row(gg, "", "mu_s", t->gg_mu_s, t->gg_mu_s_range, gb->mu_s_min, gb->mu_s_max, t->gg_angle_matched);
+    rows[n++] = friction_row(gg, "", "mu_r", t->gg_mu_r, t->gg_mu_r_range, gb->mu_r_min, gb->mu_r_max, t->gg_angle_matched);
+    for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gw, k_names[k], exp_boundary_stiffness(t->k_n));
+    rows[n++] = plain_row(gw, "xi", t->xi, "-", CAL_VALUE_INPUT);
+    for (int w = 0; w < t->n_walls && n + 2 <= CAL_TABLE_MAX_ROWS; ++w) {
+        int matched = t->wall_angle_matched[w];
+        rows[n++] = friction_row(gw, t->wall_name[w], "mu_s", t->wall_mu_s[w], t->wall_mu_s_range[w], wb->mu_s_min,
+                                 wb->mu_s_max, matched);
+        rows[n++] = friction_row(gw, t->wall_name[w], "mu_r", t->wall_mu_r[w], t->wall_mu_r_range[w], wb->mu_r_min,
+                                 wb->mu_r_max, matched);
+    }
+    return n;
+}
+
+// ---- the run -------------------------------------------------------------------------
+
+cal_run_status cal_run_status_of(const cal_outcome *o)
+{
+    return (cal_run_status){.demonstration = cal_tier_is_demonstration(o->tier),
+                            .tier = o->tier->name,
+                            .drum_lambda = o->tier->lambda,
+                            .cylinder_lambda = o->tier->cylinder_lambda,
+                            .stiffness_on_drum = cal_tier_stiffness_on_drum(o->tier),
+                            .angle_synthetic = o->angle_data_synthetic,
+                            .csa_synthetic = o->csa_data_synthetic};
+}
+
+const char *cal_run_purpose(const cal_run_status *s) { return s->demonstration ? "demonstration" : "calibration"; }
+
+const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s)
+{
+    snprintf(out, len, "angle %s / CSA %s", s->angle_synthetic ? "synthetic" : "lab", s->csa_synthetic ? "synthetic" : "lab");
+    return out;
+}
+
+void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix)
+{
+    if (s->demonstration)
+        fprintf(f, "%sDEMONSTRATION - not a calibration of this powder: tier '%s' is marked `purpose: demonstration` "
+                   "(too coarse for its values to stand for the powder).\n", prefix, s->tier);
+    else fprintf(f, "%sCALIBRATION at tier '%s'.\n", prefix, s->tier);
+    if (s->stiffness_on_drum)
+        fprintf(f, "%sCoarse-grained (eq. 15-18): the drum and its stiffness sweep ran at lambda = %g; the values are "
+                   "for simulations at lambda = %g.\n", prefix, s->drum_lambda, s->drum_lambda);
+    else
+        fprintf(f, "%sCoarse-grained (eq. 15-18): the drum ran at lambda = %g, the stiffness cylinder at lambda = %g; "
+                   "the values are for simulations at lambda = %g.\n", prefix, s->drum_lambda, s->cylinder_lambda,
+                s->drum_lambda);
+    fprintf(f, "%sData: repose angle %s, occupied area (CSA) %s.\n", prefix,
+            s->angle_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab",
+            s->csa_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab");
+    fprintf(f, "%sEach value's status: calibrated (chosen by the data), one-sided (a search bound the data do not "
+               "close: >= or <=), not identified (the data exclude nothing in the search range), not a result (the "
+               "search's choice lies outside the interval its own data leave), stage not run (the config's value), "
+               "input, derived.\n", prefix);
+}
+
+void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
+{
+    cal_table_row rows[CAL_TABLE_MAX_ROWS];
+    int n = cal_table_rows(o, rows);
+    for (int i = 0; i < n; ++i) {
+        const cal_table_row *r = &rows[i];
+        cal_value_status st = r->verdict.status;
+        if (st == CAL_VALUE_INPUT || st == CAL_VALUE_DERIVED || st == CAL_VALUE_CALIBRATED) continue;
+        fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
+                r->value, cal_value_status_name(st));
+        if (st == CAL_VALUE_ONE_SIDED)
+            fprintf(f, ", only %s %.6g is known (the search stopped on its bound)", r->verdict.side > 0 ? ">=" : "<=",
+                    r->verdict.known);
+        fprintf(f, " (%s)\n", r->verdict.flags);
+    }
+}

@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_case_runs.h
+/// The simulations a calibration asks for, through the result store: a
+/// drum candidate (one settled bed turned at each speed) and a poured
+/// cylinder. What is stored is never run again; what is missing is dealt
+/// out over MPI ranks and, on each machine, over worker processes.
+#ifndef CAL_CASE_RUNS_H
+#define CAL_CASE_RUNS_H
+
+#include <stdint.h>
+
+#include "cal_config.h"
+#include "cal_progress.h"
+#include "cal_store.h"
+#include "exp_cylinder.h"
+#include "exp_drum.h"
+
+/// How simulations are run and reported.
+typedef struct cal_env {
+    char store[1100];   ///< record directory
+    int workers;        ///< processes per machine
+    int use_fork;
+    int tty;            ///< progress on a terminal
+    char stage[64];     ///< label of the current stage, for progress lines
+    double started;     ///< wall clock at the start of the calibration
+    /// Wall seconds between a drum run's checkpoints in the store (0: none):
+    /// a killed run, run again, resumes its turn from the last one.
+    double checkpoint_every_s;
+    unsigned long long simulations_run; ///< by this process (the rest came from the store)
+    cal_progress *progress;             ///< the whole calibration's, or NULL (a study, a single run)
+    int mapping;                        ///< 1 while a two-tier stage's map tier runs: its drum runs
+                                        ///< are counted as CAL_RUN_MAP_DRUM, its stage "NAME (map)"
+    /// The last settled bed and the text that defined it: the wall stage's
+    /// candidates all turn the same one (cal_drum_case_wall), so it is
+    /// settled once per process. Freed by cal_sim_release.
+    dem_world *kept_bed;
+    char kept_text[1024];
+} cal_env;
+
+/// Name the stage that progress lines are labelled with.
+void cal_env_set_stage(cal_env *env, const char *stage);
+
+/// Default wall seconds between a drum run's checkpoints: a kill costs at
+/// most this much turning, and a save (a few MB at λ 1000) is a small share.
+#define CAL_CHECKPOINT_EVERY_S 120.0
+
+/// A drum candidate: the drum and powder, how its bed is settled, and how
+/// each speed is run.
+enum { CAL_CASE_MAX_RPM = 32 };
+
+typedef struct cal_drum_case {
+    exp_drum_def def;  ///< turned with these pairs
+    exp_drum_def fill; ///< settled with these (the same drum; only the wall pair may differ)
+    exp_drum_run_opts run;
+    /// Speeds averaged for another time than run.average_time (a tier's
+    /// average_time_per_rpm); read through cal_drum_run_opts.
+    int n_average;
+    double average_rpm[CAL_CASE_MAX_RPM], average_time[CAL_CASE_MAX_RPM];
+} cal_drum_case;
+
+/// The run options of case c turned at `rpm`: its speed, and its averaging
+/// time at that speed.
+exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm);
+
+/// Stage 2: the drum lined with granules (wall pair = granule pair) at
+/// granule stiffness k_n, settled and turned with that pair. The bed's
+/// packing, hence its CSA, depends on the granule pair, so each candidate
+/// settles its own bed (same seed: the same granules at the same places).
+cal_drum_case cal_drum_case_granule(const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r);
+
+/// Stage 3: the granule pair frozen, a wall material's pair (wall_mu_s,
+/// wall_mu_r). Every candidate turns the same bed, settled in the drum lined
+/// with granules: the wall changes only the boundary layer of a poured bed, so
+/// one fill serves the whole stage (a fill costs about as much as a turn).
+cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
+                                 double wall_mu_s, double wall_mu_r);
+
+/// Free the settled bed kept between candidates (at the end of a run).
+void cal_sim_release(cal_env *env);
+
+/// The poured cylinder of stage 1 at stiffness k_n and seed.
+exp_cylinder_def cal_cylinder_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);
+
+/// A stage-1 bed: the poured cylinder, or the tier's drum's own poured bed
+/// (its tier's stiffness_scene), both poured with the config's prior friction.
+typedef struct cal_bed_case {
+    int on_drum;               ///< 1: drum_bed (exp_drum_bed_run), 0: cylinder (exp_cylinder_run)
+    exp_cylinder_def cylinder;
+    exp_drum_def drum_bed;     ///< the tier's drum, granule and wall pairs at pour_mu_s, pour_mu_r
+} cal_bed_case;
+
+/// Stage 1's bed at tier t, stiffness k_n and seed, in the tier's scene.
+cal_bed_case cal_bed_case_make(const cal_config *c, const cal_tier *t, double k_n, uint64_t seed);
+/// Its record's key: the cylinder's key (cal_cylinder_key), or "drum_bed "
+/// and the drum definition's text (all that defines the settled bed).
+void cal_bed_key(const cal_bed_case *b, char *out, size_t len);
+
+/// The text that defines a simulation (hashed into its record's name).
+void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len);
+void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
+
+/// Records of the drum candidate at each speed, running the missing ones.
+/// 0 when every record is in hand (failed simulations included), else 1
+/// with a message (the store could not be read or written).
+int cal_drum_evaluate(cal_env *env, const cal_drum_case *c, const double *rpm, int n, cal_record *out, char *err,
+                      size_t len);
+/// The same for several candidates at once (out: n_cases × n records, by
+/// candidate): their missing runs share the workers, so one candidate's long
+/// speed does not leave the others idle.
+int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases, const double *rpm, int n,
+                           cal_record *out, char *err, size_t len);
+
+/// What one stage-1 bed is expected to cost before it runs, in particle-steps,
+/// and its peak memory (MB): the cylinder's exp_cylinder_predict_cost, or the
+/// drum fill's (exp_drum_predict_cost).
+double cal_bed_predict_particle_steps(const cal_bed_case *b, double *memory_mb);
+
+/// Records of stage-1 beds, running the missing ones side by side.
+int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record *out, char *err, size_t len);
+
+#endif

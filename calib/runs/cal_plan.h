@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_plan.h
+/// The cost model behind every `--plan` (calibrate, synthesize, study): what
+/// a simulation costs in core-seconds, predicted from its particle-steps, and
+/// what a batch of them takes in wall time on the workers. Each plan gives two
+/// figures: the EXPECTED cost (a drum run ends at the steady test's first
+/// chance, the searches run their typical counts) and the WORST case (every
+/// run turns for max_time, every search runs its every evaluation).
+#ifndef CAL_PLAN_H
+#define CAL_PLAN_H
+
+#include "cal_case_runs.h"
+
+/// Particle-steps a core does per second in a whole drum run (turning,
+/// measuring, checks): measured on this project's 2-core machine at 4d0268d
+/// (results/benchmarks/drum_end_to_end.md, "The stiffness stage 1 chooses":
+/// 1.46e7 at k_n 50 N/m and 1.52e7 at 200 N/m on the λ 1000 drum; the kernel
+/// 1.45-1.60e7 at d07c877). Another machine scales every figure of a plan.
+#define CAL_PLAN_RATE 1.5e7
+
+/// What a plan adds up.
+typedef struct cal_plan_cost {
+    int runs;           ///< simulations
+    double core_s;      ///< their single-core seconds
+    double wall_s;      ///< on the workers, batch after batch
+    double memory_mb;   ///< the largest simulation's peak memory
+} cal_plan_cost;
+
+/// The figures of a plan: expected, and worst case.
+typedef struct cal_plan {
+    cal_plan_cost expected, worst;
+} cal_plan;
+
+/// What a drum run's expected and worst-case figures assume (cal_plan_turn_time), as a plan prints it.
+#define CAL_PLAN_RUN_ASSUMPTION \
+    "expected: each run ends at the steady test's first chance (two windows, then its averaging); worst case: max_time."
+
+/// Add plan p to a total, expected and worst case alike (runs, seconds; the
+/// largest memory).
+void cal_plan_add(cal_plan *total, const cal_plan *p);
+
+/// Simulated seconds a drum run of case d turns at rpm: the worst case
+/// max_time; expected, the steady test's first chance (its two windows, then
+/// the averaging time), at most max_time. Every λ 1000 run of the committed
+/// standard calibration ended within 0.75 s of that (results/calibration-standard/
+/// simulations.csv: 10.05-10.75 s at 4 rpm, 4.0-4.1 s at 40 and 116).
+double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst);
+
+/// m drum candidates like d, each on `beds` beds (seeds), turned at the n
+/// speeds rpm[], run together as one batch the way cal_drum_evaluate_many
+/// runs them: where every run settles the same bed (one candidate on one
+/// bed, or a wall stage on one bed) the bed is settled first, unless
+/// `bed_kept` (a wall stage's bed settled earlier in the process), and each
+/// run is a task; otherwise each candidate's bed is a task that settles it
+/// and turns its speeds in turn. Added to *cost.
+void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const double *rpm, int n, int m, int beds,
+                         int wall_stage, int bed_kept, int parallel, int worst);
+
+/// A batch of n independent tasks of task_s core-seconds each on `parallel`
+/// workers: the longest task or the total shared out, whichever is longer.
+double cal_plan_makespan(const double *task_s, int n, int parallel);
+
+/// "4.2 core-hours, 2.4 h on 2 worker(s)" and the like: hours with two
+/// significant figures.
+void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t len);
+
+#endif

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: MIT
+/// @file cal_stages.h
+/// The three stages of the calibration (the paper's section 4):
+///   1. stiffness: coordination number of a poured cylinder against k_n;
+///   2. granule–granule (μs, μr) in the drum lined with granules;
+///   3. each wall material's (μs, μr), granule–granule frozen.
+#ifndef CAL_STAGES_H
+#define CAL_STAGES_H
+
+#include "cal_case_runs.h"
+#include "cal_config.h"
+#include "cal_data.h"
+#include "cal_multifidelity.h"
+
+enum { CAL_MAX_K = 64, CAL_MAX_EVALS = 512, CAL_MAX_RPM = 16 };
+
+typedef struct cal_stiffness_result {
+    int n;                       ///< stiffness candidates
+    const char *scene;           ///< the bed swept, read after "the": "poured cylinder" or "drum's own poured bed"
+    double k[CAL_MAX_K];
+    double cn_mean[CAL_MAX_K], cn_sd[CAL_MAX_K]; ///< over seeds
+    double wall_cn[CAL_MAX_K], solid_fraction[CAL_MAX_K];
+    int granules[CAL_MAX_K], failed[CAL_MAX_K];
+    double stiff_limit;          ///< CN at the stiffest candidate
+    double tolerance;            ///< |CN - stiff limit| allowed
+    const char *tolerance_rule;  ///< how the tolerance was set
+    double chosen_k;
+    int resolved;                ///< 0 if even the softest candidate is within the tolerance: the sweep shows no change
+    double wall_time_s;
+} cal_stiffness_result;
+
+int cal_stage_stiffness(cal_env *env, const cal_config *c, const cal_tier *t, cal_stiffness_result *out, char *err,
+                        size_t len);
+
+/// Stage 1's rule on measured k, cn_mean, stiff_limit and tolerance: the
+/// smallest k from which every stiffer candidate is within the tolerance of
+/// the stiff limit (chosen_k), resolved only if every softer candidate is
+/// outside it (the departure persists as k softens).
+void cal_stiffness_choose(cal_stiffness_result *s);
+
+/// One evaluated (μs, μr) candidate.
+typedef struct cal_candidate {
+    double mu_s, mu_r;
+    double angle_deg, angle_sd_deg;     ///< at the angle's speed
+    double csa[CAL_MAX_RPM], csa_sd[CAL_MAX_RPM];
+    int usable[CAL_MAX_RPM];            ///< steady and not failed
+    double misfit;                      ///< mean squared CSA misfit in data standard deviations (+ penalties)
+    double angle_violation;             ///< |angle - target| - tolerance (≤ 0: matches)
+    double objective;                   ///< what the search minimises: the CSA misfit, or with the
+                                        ///< angle's squared z-score as one more term (angle_in_misfit)
+    const char *origin;                 ///< "grid", "COBYLA", "bound probe", "two-tier" or "map + correction"
+    int predicted;                      ///< 1: not run at this tier but the corrected cheap map's value
+                                        ///< at a cheap candidate (two-tier stage): in the identified
+                                        ///< range, never the chosen pair
+    double chi2;                        ///< χ² against the data with the lab's and the tier's spreads (identification)
+    int identified;                     ///< 1 if the data cannot tell it from the best χ² (Δχ² within the threshold)
+    double wall_time_s;
+} cal_candidate;
+
+/// The range of one parameter over the candidates the data cannot tell apart.
+/// The candidates are a sparse set, so [lo, hi] alone can be narrower than
+/// what the data say (one μs value identified says nothing of the gap to the
+/// nearest excluded one): the bracket is the interval no evaluated candidate
+/// excludes, from the nearest excluded value beyond each end, or the search
+/// bound where nothing beyond was excluded.
+typedef struct cal_range {
+    double lo, hi;       ///< smallest and largest value among them
+    double below, above; ///< the nearest excluded candidate's value beyond each end; NAN: none evaluated there
+    double bracket_lo, bracket_hi; ///< below/above, or the search bound where NAN (cal_range_bracket)
+} cal_range;
+
+/// No range (the stage was not run).
+#define CAL_NO_RANGE_INIT {NAN, NAN, NAN, NAN, NAN, NAN}
+#define CAL_NO_RANGE ((cal_range)CAL_NO_RANGE_INIT)
+
+/// Set g's bracket from below/above and the search bounds.
+void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi);
+
+/// What a friction stage found.
+typedef struct cal_friction_result {
+    char material[32];                  ///< "" for granule–granule
+    char surface[64];
+    double k_n;
+    double frozen_mu_s, frozen_mu_r;    ///< granule–granule pair (wall stage)
+    double angle_target, angle_tolerance, angle_rpm; ///< the data's angle, its tolerance (data and tier spreads)
+    int angle_in_misfit;                             ///< the tier's angle_rule is "misfit"
+    int n_rpm;
+    double rpm[CAL_MAX_RPM], csa_data[CAL_MAX_RPM], csa_data_sd[CAL_MAX_RPM];
+    double csa_tier_sd[CAL_MAX_RPM];    ///< the tier's measured seed spread at each speed (0: not measured)
+    cal_provenance angle_source, csa_source; ///< whether the data files' numbers are synthetic (the figures say so)
+    int n;                              ///< candidates evaluated
+    cal_candidate cand[CAL_MAX_EVALS];
+    int best;                           ///< index of the chosen candidate, -1 if none usable
+    int best_feasible;                  ///< 1 if it matches the angle
+    double chi2_least;                  ///< the smallest χ² of the candidates
+    double chi2_threshold;              ///< Δχ² within which candidates are not told apart
+    cal_range mu_s_range, mu_r_range;   ///< what the data identify (cal_friction_identify)
+    int identified_count;               ///< candidates within the threshold
+    const char *nlopt_result;
+    double wall_time_s;
+    int simulations;                    ///< drum runs of this tier's candidates (stored ones included)
+    double core_s;                      ///< what they cost, single-core seconds (their records' costs)
+    /// Two-tier stage (tier with map_tier): the cheap tier, its runs and
+    /// cost, the correction measured (angle, then CSA per speed), and how the
+    /// loop ended. map_tier[0] == 0: a one-tier stage.
+    char map_tier[32];
+    int map_candidates, expensive_candidates;
+    double map_wall_time_s;
+    int map_simulations;                ///< the map tier's drum runs, and their single-core seconds
+    double map_core_s;
+    double correction[CAL_MAX_RPM + 1]; ///< at the last run (cal_mf_result.delta)
+    double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
+    const char *two_tier_outcome;
+    const char *map_correction;         ///< "kriging" or "affine" (cal_mf_correction_kind)
+    /// The map the two-tier search ended with: the map tier's quadratic map in
+    /// this stage's unit square and the discrepancy measured at this tier's
+    /// runs (the posterior samples it: cal_posterior.h). has_map 0: a one-tier
+    /// stage, or a loop that made no run.
+    int has_map;
+    cal_mf_map cheap_map;
+    cal_mf_correction discrepancy;
+} cal_friction_result;
+
+/// A candidate's scores from its measurements (angle_deg, csa, usable):
+/// angle_violation, the CSA misfit and the search's objective, by the rule
+/// in r (angle_in_misfit, targets, tolerance, data).
+void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
+/// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
+int cal_friction_best(const cal_friction_result *r);
+
+/// The identified ranges (docs/calibration.md "Identified ranges"): each candidate's χ²
+/// against every measurement (the angle by its tolerance, each CSA speed by
+/// the lab's and the tier's spreads combined; a failed measurement counts
+/// as 5 standard deviations), then every candidate whose χ² is within
+/// Δχ² = 3.84 of the smallest (one parameter's 95 % confidence interval,
+/// the χ² distribution with 1 degree of freedom) is one the data cannot
+/// tell from the best; μs and μr range over those. Needs csa_tier_sd set.
+void cal_friction_identify(cal_friction_result *r);
+
+/// The drum runs stage 2 (material == NULL) or 3 may take at tier t at most:
+/// its speeds times beds times (grid points + COBYLA's evaluations + bound
+/// probes), or with a map tier times its max_evaluations (the map tier's
+/// runs are its own plan); -1 if the data lack the stage's surface (the stage
+/// itself then says why).
+int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
+                              const cal_series *areas, const cal_material *material);
+
+/// A friction search in progress (targets set from the data, candidates so far).
+typedef struct cal_friction_search cal_friction_search;
+
+/// Start a stage's search: out's targets and tolerances from the data; NULL
+/// and a message if the data lack them.
+cal_friction_search *cal_friction_begin(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                                        const cal_series *areas, double k_n, const cal_material *material,
+                                        double gg_mu_s, double gg_mu_r, cal_friction_result *out, char *err, size_t len);
+/// Run (or find) the candidate at (mu_s, mu_r); NULL when the store failed.
+cal_candidate *cal_friction_evaluate(cal_friction_search *s, double mu_s, double mu_r, const char *origin);
+/// The search's bounds (granule or wall).
+const cal_bounds *cal_friction_bounds(const cal_friction_search *s);
+/// Choose the best, identify the ranges, free the search; 1 with the message
+/// if a simulation could not be stored or every candidate failed.
+int cal_friction_finish(cal_friction_search *s);
+
+/// The speeds stage 2 (material == NULL) or 3 simulates at tier t, as its
+/// search does: the data's CSA speeds for the stage's surface (those of the
+/// tier's rpm list, if it has one), then the angle's speed if not among them
+/// (in *angle_rpm, unless NULL). How many, or -1 with a message.
+int cal_friction_speeds(const cal_config *c, const cal_tier *t, const cal_series *angles, const cal_series *areas,
+                        const cal_material *material, double rpm[CAL_MAX_RPM], double *angle_rpm, char *err, size_t len);
+
+/// Stage 2 (material == NULL) or 3 (a material of the config), one tier.
+int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                       const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
+                       double gg_mu_r, cal_friction_result *out, char *err, size_t len);
+
+/// The drum case of the stage r at (mu_s, mu_r) on bed `bed` (seed + bed):
+/// what the search runs, and what the report looks up in the store.
+cal_drum_case cal_friction_case(const cal_config *c, const cal_tier *t, const cal_friction_result *r, double mu_s,
+                                double mu_r, int bed);
+
+/// The unit square's (u, v) as (μs, log μr) within bounds b, and back.
+void cal_friction_to_mu(const cal_bounds *b, double u, double v, double *mu_s, double *mu_r);
+void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double *u, double *v);
+/// Speed i's CSA spread in the χ² and the misfit: the lab's (floored) and the
+/// tier's in quadrature.
+double cal_friction_csa_spread(const cal_friction_result *r, int i);
+/// The angle's spread in the χ² and the misfit: its tolerance, floored.
+double cal_friction_angle_spread(const cal_friction_result *r);
+/// A candidate's measurement vector: its angle, then its CSA at each speed
+/// (the order of cal_mf_point.y); 1 if a measurement is missing (failed or
+/// unsteady: not a point of any map).
+int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y);
+
+/// The same stage across two tiers (the tier's map_tier maps, the tier itself
+/// decides; cal_multifidelity.h): the cheap tier's whole search first (its
+/// candidates in cheap_out), then the tier's own runs where the corrected map
+/// puts the optimum.
+int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
+                       const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
+                       double gg_mu_r, cal_friction_result *out, cal_friction_result *cheap_out, char *err, size_t len);
+
+#endif
