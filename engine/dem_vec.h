@@ -13,7 +13,11 @@
 
 /// Force inlining of a hot kernel that the compiler's size heuristics would
 /// otherwise leave as a call (the contact law inside the pair loop).
-#if defined(__GNUC__) || defined(__clang__)
+/// DEM_NO_FORCED_INLINE (the sanitizer build, CMakeLists.txt) leaves the
+/// choice to the compiler: forced into every one of dem_pairs.c's pair loops
+/// and instrumented, the kernel made that one file take minutes of CPU to
+/// compile. Inlining changes no arithmetic, only where the code sits.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(DEM_NO_FORCED_INLINE)
 #define DEM_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define DEM_ALWAYS_INLINE inline
