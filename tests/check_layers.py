@@ -94,7 +94,11 @@ ARROWS = {
 
 # Includes known to break a rule and being removed: (file, header) -> why it is
 # still there. Reported, not failed on; a line that is gone is reported too.
-KNOWN_INCLUDES = {}
+KNOWN_INCLUDES = {
+    ("experiments/compress/exp_compress.c", "exp_scene.h"): (
+        "unused since the located-error helpers moved to exp_yaml.h (issue 38); exp_compress.c is being "
+        "rewritten on another branch, so the line goes with that change"),
+}
 
 
 def module_of(name):
