@@ -42,6 +42,9 @@ static void keep(int index, const exp_drum_measure *m, void *ctx)
     s->n = index + 1;
 }
 
+// Samples in t seconds of turning, rounded as exp_drum.c counts its windows.
+static int samples_in(const exp_drum_run_opts *o, double t) { return (int)(t / o->sample_interval + 0.5); }
+
 static void mean_over(const series *s, int from, int to, double *angle, double *csa)
 {
     double a = 0, c = 0;
@@ -82,10 +85,10 @@ int main(int argc, char **argv)
     exp_drum_result r;
     if (exp_drum_rotate(w, &d.def, &o, NULL, NULL, &r) != DEM_OK || !r.steady)
         return fprintf(stderr, "the run failed or was not steady\n"), 1;
-    int per_window = (int)(o.window / o.sample_interval + 0.5), avg = (int)(o.average_time / o.sample_interval + 0.5);
+    int per_window = samples_in(&o, o.window), avg = samples_in(&o, o.average_time);
     int steady_at = s.n - avg, from = steady_at - 2 * per_window;
     // What the tier's own run reported: the mean over its averaging (the same sum as exp_drum.c's).
-    mean_over(&s, from, steady_at + (int)(tier_average_time / o.sample_interval + 0.5), &r.angle_deg, &r.csa_percent);
+    mean_over(&s, from, steady_at + samples_in(&o, tier_average_time), &r.angle_deg, &r.csa_percent);
     const int same = rec.angle_deg == r.angle_deg && rec.csa_percent == r.csa_percent;
     printf("record: angle %.17g, CSA %.17g; this run: angle %.17g, CSA %.17g (%s the record); steady test held at "
            "%.2f s of turning\n",
@@ -94,13 +97,13 @@ int main(int argc, char **argv)
     char *list = strdup(argv[9]), *save = NULL;
     for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         double T = atof(tok), angle, csa;
-        int to = steady_at + (int)(T / o.sample_interval + 0.5);
+        int to = steady_at + samples_in(&o, T);
         if (to > s.n) continue;
         mean_over(&s, from, to, &angle, &csa);
         printf("average_time=%g turned_s=%.2f angle_deg=%.17g csa_percent=%.17g\n", T, to * o.sample_interval, angle,
                csa);
     }
-    const int block = (int)(2.0 / o.sample_interval + 0.5);
+    const int block = samples_in(&o, 2.0);
     for (int b0 = steady_at; b0 + block <= s.n; b0 += block) {
         double angle, csa;
         mean_over(&s, b0, b0 + block, &angle, &csa);
