@@ -12,7 +12,7 @@
 #     the script says how many records that left to draw from.
 #   With SAYS="TIER PURPOSE DATA" set (e.g. "standard calibration angle lab / CSA synthetic"), the
 #   re-derived outputs must also say what the run is (check_outputs_say_what.py).
-#   usage: [MAX_RERUN_S=S] [SEED=N] [SAYS=...] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
+#   usage: [MAX_RERUN_S=S] [SEED=N] [SAYS=...] [JOBS=J] verify_committed.sh GRANUCAL SOURCE_DIR RESULTS_DIR WORK_DIR [N]
 #   (N = 0: step 1 alone)
 # RESULTS_DIR holds report.md, calibrated_parameters.csv, simulations.csv, store/, the stage_*.yaml
 # files, and the data files the run read (repose_angle.csv, occupied_area.csv): for a run made with
@@ -45,7 +45,10 @@ if ! grep -q -- "--data" <<< "${args[*]}" && [ -f "$results/repose_angle.csv" ] 
 fi
 cp -r "$results/store" "$work/out/"
 cp "$results"/stage_*.yaml "$work/out/" 2>/dev/null || true
-run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs 2 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
+# JOBS: the workers (default 2). A batch of one simulation gets every idle worker's core as an OpenMP
+# thread (cal_pool.c), so a test declared as one core must say JOBS=1: two threads beside another test
+# on a 2-core machine spin against each other (a lambda 1000 run measured 10x slower that way).
+run() { (cd "$src" && "$bin" calibrate "${args[@]}" --jobs "${JOBS:-2}" 2> "$work/$1.log" > /dev/null) || { cat "$work/$1.log"; exit 1; }; }
 ran() { sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/$1.log"; }
 fails=0
 
