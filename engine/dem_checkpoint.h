@@ -10,7 +10,15 @@
 /// The file is written under `<path>.tmp` and renamed into place, so a kill
 /// while writing leaves the previous checkpoint whole. It is tied to the
 /// build that wrote it: the world's memory layout is part of the file, and a
-/// checkpoint of another layout is refused, never misread.
+/// checkpoint of another layout is refused, never misread. The world's
+/// definition is in it (its network check interval, each wall's prescribed
+/// motion) with the steps since its last network check: a resumed run moves
+/// its walls and checks its step where the run that wrote it would have. A
+/// checkpoint of the layout before those (issue 38) is refused with the
+/// message "written by another build of the engine", not loaded with
+/// defaults: where its next check falls is not in it, and a run resumed
+/// without it would not be the run that wrote it; the drum then turns afresh
+/// (its note says why), ending as the uninterrupted run.
 #ifndef DEM_CHECKPOINT_H
 #define DEM_CHECKPOINT_H
 

@@ -42,7 +42,8 @@ struct dem_world {
     unsigned char *fixed;
     size_t n_fixed;
 
-    // Walls: never moved by the solver.
+    // Walls: moved by the step only as their prescribed motion says
+    // (dem_wall_def.motion).
     int n_walls;
     dem_wall walls[DEM_MAX_WALLS];
 
@@ -78,6 +79,12 @@ struct dem_world {
     double hist_dt; // dt when positions moved since the last force evaluation, else 0
     int moved;
     uint64_t step;
+    // The step's own network checks (def.network_check_interval, dem_step.c):
+    // the steps since the last one, on which the next is scheduled (a resumed
+    // run checks where the run that wrote the checkpoint would have), and
+    // what they found.
+    uint64_t steps_since_check;
+    dem_network_checks checks;
     int prepared, forces_valid;
     char err[512];
     char dt_report[512];

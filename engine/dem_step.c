@@ -367,9 +367,25 @@ typedef struct team_slot {
     char pad[64 - 3 * sizeof(size_t) - 3 * sizeof(double)];
 } team_slot;
 
-// Walls move only between calls (dem_world_set_wall_point): one that moved
-// half a skin leaves the first step to the ordinary path, whose list refresh
-// sees it.
+// Whether a wall of the world has a prescribed motion (dem_wall_def.motion).
+static int walls_move(const dem_world *w)
+{
+    for (int k = 0; k < w->n_walls; ++k)
+        if (w->walls[k].def.motion != DEM_WALL_STANDS) return 1;
+    return 0;
+}
+
+// One step of every wall's prescribed motion, before the step's kick and
+// drift: where a caller moved the wall between single steps, so that the
+// step's force evaluation sees it there.
+static void move_walls(dem_world *w)
+{
+    for (int k = 0; k < w->n_walls; ++k) dem_wall_advance(&w->walls[k], w->dt);
+}
+
+// A wall placed by a caller, or moved by the step before the team, that has
+// moved half a skin leaves the step to the ordinary path, whose list refresh
+// sees it (the team checks its own walls' moves after each drift).
 static int team_eligible(const dem_world *w)
 {
     return w->list_valid && dem_forces_threaded(w) && dem_forces_blockwise(w) && !dem_lists_walls_moved(w);
@@ -426,7 +442,11 @@ static void team_crossing_pairs(dem_world *w, const team_slot *slot, const uint3
 
 // One thread's part of up to `steps` steps; every thread reaches the same
 // stop. `rows`: n entries, each block's crossing rows at its own start.
-static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, uint64_t steps)
+// `moving`: walls with a prescribed motion, which thread 0 moves before each
+// step but the first (moved by the caller, dem_world_step): the barrier at
+// the end of the step before keeps every thread's last force evaluation
+// ahead of the move, the one after the drift the move ahead of the next.
+static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, uint64_t steps, int moving)
 {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     const double half_skin = 0.5 * w->skin;
@@ -435,13 +455,14 @@ static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, ui
     slot[t].crossing_rows = dem_forces_crossing_rows(w, lo, hi, rows + lo); // the list stays through the region
     team_result r = {0, TEAM_DONE, SIZE_MAX};
     while (r.steps < steps) {
+        if (moving && t == 0 && r.steps > 0) move_walls(w);
         slot[t].escaped = kick_drift_range(w, lo, hi);
         slot[t].displacement2 = dem_lists_displacement2_range(w, lo, hi);
         dem_forces_axis_extent(w, lo, hi, &slot[t].lowest, &slot[t].highest);
 #pragma omp barrier
         r.bad = team_first(slot, nt, 0);
         if (r.bad != SIZE_MAX || team_max_displacement2(slot, nt) > half_skin * half_skin ||
-            !team_one_wrap(w, slot, nt)) {
+            !team_one_wrap(w, slot, nt) || (moving && dem_lists_walls_moved(w))) {
             r.stop = TEAM_AFTER_DRIFT;
             return r;
         }
@@ -464,7 +485,7 @@ static team_result team_thread(dem_world *w, team_slot *slot, uint32_t *rows, ui
 // scratch could not be had (the ordinary step then goes on). The scratch and
 // the crossing rows are made once per region, i.e. per call and per list
 // rebuild: not per step, except for a caller that steps one step per call.
-static team_result step_team(dem_world *w, uint64_t steps)
+static team_result step_team(dem_world *w, uint64_t steps, int moving)
 {
     team_result r = {0, TEAM_DONE, SIZE_MAX};
     const int team = dem_world_team(w);
@@ -475,7 +496,7 @@ static team_result step_team(dem_world *w, uint64_t steps)
         dem_forces_blocks_begin(w);
 #pragma omp parallel num_threads(team)
         {
-            const team_result mine = team_thread(w, slot, rows, steps);
+            const team_result mine = team_thread(w, slot, rows, steps, moving);
             if (omp_get_thread_num() == 0) r = mine; // every thread's is the same
         }
     }
@@ -515,28 +536,31 @@ static dem_status finish_step(dem_world *w, size_t escaped)
     return DEM_OK;
 }
 
-dem_status dem_world_step(dem_world *w, uint64_t steps)
+// Forces of the state the next step starts from, where no evaluation holds
+// (a new world, or a changed contact law, spin or step: a network check that
+// lowered dt within a call re-evaluates here as the next call would have).
+static dem_status ensure_forces(dem_world *w)
 {
-    dem_status st = dem_world_prepare(w);
+    if (w->forces_valid) return DEM_OK;
+    if (dem_lists_refresh(w)) return DEM_ERR_NOMEM;
+    w->hist_dt = w->moved ? w->dt : 0.0; // re-evaluation at an unchanged configuration: springs stay
+    if (evaluate(w)) return DEM_ERR_NOMEM;
+    w->moved = 0;
+    w->forces_valid = 1;
+    return DEM_OK;
+}
+
+// `steps` steps, each after its walls' prescribed motion, on the team where
+// it can run them.
+static dem_status step_run(dem_world *w, uint64_t steps)
+{
+    dem_status st = ensure_forces(w);
     if (st != DEM_OK) return st;
-    // A state that is already not finite (put there through
-    // dem_world_set_granule_velocity, or left by an earlier fault) is reported
-    // against its own granule before anything is computed from it: the force
-    // evaluation would pass the NaN to its contact partners, and the first of
-    // those by index would be named; the drift would make its position NaN,
-    // which the domain test would report as an escape. One pass per call.
-    size_t bad0 = first_nonfinite(w);
-    if (bad0 != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad0, "non-finite state (NaN or infinity)");
-    if (!w->forces_valid) {
-        if (dem_lists_refresh(w)) return DEM_ERR_NOMEM;
-        w->hist_dt = w->moved ? w->dt : 0.0; // re-evaluation at an unchanged configuration: springs stay
-        if (evaluate(w)) return DEM_ERR_NOMEM;
-        w->moved = 0;
-        w->forces_valid = 1;
-    }
+    const int moving = walls_move(w);
     for (uint64_t s = 0; s < steps; ++s) {
+        if (moving) move_walls(w);
         if (team_eligible(w)) {
-            const team_result r = step_team(w, steps - s);
+            const team_result r = step_team(w, steps - s, moving);
             advance_clock(w, r.steps);
             s += r.steps;
             if (r.stop == TEAM_NONFINITE) return fault(w, DEM_ERR_NONFINITE, r.bad, "non-finite state (NaN or infinity)");
@@ -553,3 +577,78 @@ dem_status dem_world_step(dem_world *w, uint64_t steps)
     return DEM_OK;
 }
 
+// ------------------------------------------------ the scheduled checks ---
+//
+// The world's network checks (dem_world_def.network_check_interval) are
+// counted in steps, never by comparing simulated times (sums of dt that two
+// ways of stepping could round apart): round(interval/chunk) chunks of
+// round(chunk/dt) steps, the rounding a caller stepping in chunks does
+// itself, so that each check falls at the end of one of its chunks, and,
+// after a lowered step, on chunks of the new length. A call is cut into runs
+// that end where a check is due; the runs step as one call would.
+
+static int checks_on(const dem_world *w) { return w->def.network_check_interval > 0; }
+
+// Steps from one check to the next at the step now in use (at least 1).
+static uint64_t check_every(const dem_world *w)
+{
+    const double interval = w->def.network_check_interval, chunk = w->def.network_check_chunk;
+    uint64_t steps = chunk > 0 ? (uint64_t)(interval / chunk + 0.5) : 1;
+    steps = steps ? steps : 1; // an interval under half a chunk: every chunk
+    steps *= (uint64_t)((chunk > 0 ? chunk : interval) / w->dt + 0.5);
+    return steps ? steps : 1;
+}
+
+// Of `left` steps, those before the next check is due (0: due now).
+static uint64_t steps_before_check(const dem_world *w, uint64_t left)
+{
+    if (!checks_on(w)) return left;
+    const uint64_t every = check_every(w), due = every > w->steps_since_check ? every - w->steps_since_check : 0;
+    return due < left ? due : left;
+}
+
+// The check itself, and what it found in the world's totals.
+static dem_status network_check(dem_world *w)
+{
+    const double t0 = omp_get_wtime();
+    dem_network_dt_check c;
+    const dem_status st = dem_world_check_network_dt(w, &c);
+    dem_network_checks *k = &w->checks;
+    k->wall_s += omp_get_wtime() - t0;
+    k->checks++;
+    if (!isnan(c.margin)) k->margin_min = isnan(k->margin_min) ? c.margin : fmin(k->margin_min, c.margin);
+    k->lowered += (uint64_t)c.lowered;
+    return st;
+}
+
+// `run` steps done: the check, if it is due.
+static dem_status count_steps(dem_world *w, uint64_t run)
+{
+    if (!checks_on(w)) return DEM_OK;
+    w->steps_since_check += run;
+    if (w->steps_since_check < check_every(w)) return DEM_OK;
+    w->steps_since_check = 0;
+    return network_check(w);
+}
+
+dem_status dem_world_step(dem_world *w, uint64_t steps)
+{
+    dem_status st = dem_world_prepare(w);
+    if (st != DEM_OK) return st;
+    // A state that is already not finite (put there through
+    // dem_world_set_granule_velocity, or left by an earlier fault) is reported
+    // against its own granule before anything is computed from it: the force
+    // evaluation would pass the NaN to its contact partners, and the first of
+    // those by index would be named; the drift would make its position NaN,
+    // which the domain test would report as an escape. One pass per call.
+    size_t bad0 = first_nonfinite(w);
+    if (bad0 != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad0, "non-finite state (NaN or infinity)");
+    st = ensure_forces(w);
+    for (uint64_t done = 0; st == DEM_OK && done < steps;) {
+        const uint64_t run = steps_before_check(w, steps - done);
+        st = step_run(w, run);
+        done += run;
+        if (st == DEM_OK) st = count_steps(w, run);
+    }
+    return st;
+}

@@ -43,3 +43,15 @@ dem_vec3 dem_wall_force_total(const dem_wall *wall)
     for (size_t k = 0; k < wall->near_count; ++k) sum = dem_v3_add(sum, wall->force[k]);
     return dem_v3_neg(sum);
 }
+
+void dem_wall_advance(dem_wall *wall, double dt)
+{
+    if (wall->def.motion != DEM_WALL_TRANSLATES) return;
+    const dem_vec3 s = wall->def.step_displacement;
+    const dem_vec3 d = s.x != 0.0 || s.y != 0.0 || s.z != 0.0 ? s : dem_v3_scale(wall->def.velocity, dt);
+    // Only the components that move: adding +0 turns a −0 coordinate into +0,
+    // and a caller who moved the wall along one axis changed only that one.
+    if (d.x != 0.0) wall->def.point.x += d.x;
+    if (d.y != 0.0) wall->def.point.y += d.y;
+    if (d.z != 0.0) wall->def.point.z += d.z;
+}

@@ -49,6 +49,10 @@ static inline double dem_wall_travel2(const dem_wall *wall)
     return dem_v3_norm2(dem_v3_sub(wall->def.point, wall->point_at_build));
 }
 
+// One step of the wall's prescribed motion (dem_wall_def.motion), at step
+// `dt`; nothing for a wall that stands.
+void dem_wall_advance(dem_wall *wall, double dt);
+
 // Geometry of a granule against a wall: overlap, unit normal from the granule
 // towards the wall, and the contact point on the wall surface.
 typedef struct dem_wall_touch {

@@ -40,6 +40,10 @@ static int check_def(const dem_world_def *d, char *msg, size_t len)
     if (!(d->dt_safety > 0 && d->dt_safety <= 1))
         return snprintf(msg, len, "dt_safety = %g: must be in (0, 1]", d->dt_safety), 1;
     if (!(d->skin >= 0)) return snprintf(msg, len, "skin = %g: must be >= 0", d->skin), 1;
+    if (!(d->network_check_interval >= 0) || !isfinite(d->network_check_interval) ||
+        !(d->network_check_chunk >= 0) || !isfinite(d->network_check_chunk))
+        return snprintf(msg, len, "network_check_interval = %g, network_check_chunk = %g: must be >= 0",
+                        d->network_check_interval, d->network_check_chunk), 1;
     if (d->periodic_axis < -1 || d->periodic_axis > 2)
         return snprintf(msg, len, "periodic_axis = %d: must be -1, 0, 1 or 2", d->periodic_axis), 1;
     for (int a = 0; a < 3; ++a)
@@ -72,6 +76,7 @@ dem_world *dem_world_create(const dem_world_def *def, char *err, size_t err_len)
     w->implicit_springs = def->implicit_springs == DEM_IMPLICIT_AUTO ? 0 : def->implicit_springs != 0;
     w->threads = def->threads > 0 ? def->threads : 0; // OpenMP's process-wide count is the caller's
     w->lever_factor = def->lever_arm == DEM_LEVER_RADIUS ? 0.0 : 1.0;
+    w->checks.margin_min = NAN; // no check yet
     refresh_features(w);
     return w;
 }
@@ -227,6 +232,10 @@ static int check_wall_geometry(dem_world *w, const dem_wall_def *d)
     if (!isfinite(d->spin)) return dem_world_set_error(w, "wall '%s': spin must be finite", d->name ? d->name : "");
     if (!dem_v3_isfinite(d->velocity))
         return dem_world_set_error(w, "wall '%s': velocity must be finite", d->name ? d->name : "");
+    if ((unsigned)d->motion > DEM_WALL_TRANSLATES)
+        return dem_world_set_error(w, "wall '%s': motion %d unknown", d->name ? d->name : "", (int)d->motion);
+    if (!dem_v3_isfinite(d->step_displacement))
+        return dem_world_set_error(w, "wall '%s': step displacement must be finite", d->name ? d->name : "");
     return 0;
 }
 
@@ -289,6 +298,42 @@ dem_status dem_world_set_wall_velocity(dem_world *w, int wall, dem_vec3 velocity
     w->walls[wall].translating = wall_translates(&w->walls[wall].def);
     return DEM_OK;
 }
+
+// The wall's law is read by the step (dem_wall_advance), before each kick:
+// like the point, nothing computed is invalidated.
+dem_status dem_world_set_wall_translation(dem_world *w, int wall, dem_vec3 velocity, dem_vec3 step_displacement)
+{
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
+    if (!dem_v3_isfinite(step_displacement))
+        return dem_world_set_error(w, "wall %d: step displacement must be finite", wall), DEM_ERR_INVALID;
+    dem_status st = dem_world_set_wall_velocity(w, wall, velocity);
+    if (st != DEM_OK) return st;
+    w->walls[wall].def.motion = DEM_WALL_TRANSLATES;
+    w->walls[wall].def.step_displacement = step_displacement;
+    return DEM_OK;
+}
+
+dem_status dem_world_stop_wall(dem_world *w, int wall)
+{
+    if (no_wall(w, wall)) return DEM_ERR_INVALID;
+    w->walls[wall].def.motion = DEM_WALL_STANDS;
+    w->walls[wall].def.step_displacement = dem_v3(0, 0, 0);
+    return dem_world_set_wall_velocity(w, wall, dem_v3(0, 0, 0));
+}
+
+dem_status dem_world_set_network_check(dem_world *w, double interval, double chunk)
+{
+    if (!(interval >= 0) || !isfinite(interval) || !(chunk >= 0) || !isfinite(chunk))
+        return dem_world_set_error(w, "network check every %g s in chunks of %g s: both must be >= 0", interval, chunk),
+               DEM_ERR_INVALID;
+    w->def.network_check_interval = interval;
+    w->def.network_check_chunk = chunk;
+    w->steps_since_check = 0;
+    w->checks = (dem_network_checks){0, 0, NAN, 0.0};
+    return DEM_OK;
+}
+
+dem_network_checks dem_world_network_checks(const dem_world *w) { return w->checks; }
 
 const dem_wall_def *dem_world_wall(const dem_world *w, int wall)
 {

@@ -34,13 +34,20 @@ typedef enum dem_lever_arm {
     DEM_LEVER_RADIUS = 1,
 } dem_lever_arm;
 
-/// Kinds of wall. Walls are never moved by the solver; a caller may move one
-/// (dem_world_set_wall_point).
+/// Kinds of wall. The engine moves a wall only by its prescribed motion
+/// (dem_wall_def.motion); a caller may also place one (dem_world_set_wall_point).
 typedef enum dem_wall_kind {
     DEM_WALL_PLANE = 0,    ///< infinite plane; granules on the side `normal` points to
     DEM_WALL_DISC = 1,     ///< flat disc of `radius` (an end plate), one-sided like the plane
     DEM_WALL_CYLINDER = 2, ///< inner surface of a cylinder of `radius` about `axis`
 } dem_wall_kind;
+
+/// Prescribed motion of a wall, part of its definition (as MercuryDPM's walls
+/// carry theirs): the engine moves the wall itself, before every step.
+typedef enum dem_wall_motion {
+    DEM_WALL_STANDS = 0,     ///< never moved by the engine; `velocity` is its surface's only (a conveyor)
+    DEM_WALL_TRANSLATES = 1, ///< translation at constant `velocity` from where it stands (a piston)
+} dem_wall_motion;
 
 /// Definition of a wall. A wall can spin about `axis` through `point` at
 /// `spin` rad/s (a rotating drum) and translate at `velocity`: its surface
@@ -54,10 +61,21 @@ typedef struct dem_wall_def {
     double spin;      ///< angular velocity about `axis`, rad/s
     /// Translational velocity of the wall's surface, m/s (default 0): it
     /// enters the contacts' relative velocity (dashpot, tangential spring and
-    /// friction), not the wall's position; the caller moves the wall
-    /// (dem_world_set_wall_point) where the motion is not along its own
-    /// surface.
+    /// friction), not the wall's position: a wall moving other than along
+    /// its own surface is given its `motion` (dem_world_set_wall_translation).
+    /// With DEM_WALL_STANDS the engine never moves it (a conveyor).
     dem_vec3 velocity;
+    /// DEM_WALL_TRANSLATES: before each step (its kick and drift, so that
+    /// the step's force evaluation sees the wall there) the engine adds
+    /// `step_displacement` to `point`, one addition a step: the point is a
+    /// running sum, the arithmetic of a caller who moved the wall by hand
+    /// between single steps (y += travel), so that such a run keeps its bits
+    /// when the engine takes the motion over. Default DEM_WALL_STANDS.
+    dem_wall_motion motion;
+    /// m per step, DEM_WALL_TRANSLATES only; (0, 0, 0): velocity × dt of the
+    /// step. A caller whose distance per step is its own product (travel =
+    /// speed × dt, scaled) gives it here rather than have it recomputed.
+    dem_vec3 step_displacement;
     dem_contact_params contact; ///< granule–this-wall contact parameters (Table 3)
     const char *name; ///< for messages, optional
 } dem_wall_def;
@@ -105,6 +123,22 @@ typedef struct dem_world_def {
     /// Accept a configured dt above the stability limit. Only for studies of
     /// the limit itself (tests/stability); never set by configs.
     int allow_unstable_dt;
+    /// Step safety while running: every this much simulated time (s) the
+    /// step is checked against the limit of the contact network as it now is
+    /// (dem_world_check_network_dt) and lowered where it is above it; what the
+    /// checks found: dem_world_network_checks. 0 (default): never (every
+    /// scene that does not ask runs as before). A turning bed's contacts
+    /// change; the step chosen from the settled bed must stay within them.
+    double network_check_interval;
+    /// The chunk of simulated time (s) the interval is counted in; 0: one
+    /// step. The interval is round(interval/chunk) chunks of round(chunk/dt)
+    /// steps each, counted in steps since the last check (saved in
+    /// checkpoints), never by comparing simulated times: the checks fall on
+    /// the same steps on every machine and after a resume. A caller stepping
+    /// in chunks of round(chunk/dt) steps (the drum: one image sample each)
+    /// then has every check at the end of one of its chunks, also after a
+    /// lowered step has changed the steps a chunk holds.
+    double network_check_chunk;
 } dem_world_def;
 
 /// Defaults: gravity −9.81 along y, the paper's Table 3 granule–granule
@@ -154,9 +188,10 @@ int64_t dem_world_add_granule(dem_world *w, dem_vec3 position, dem_vec3 velocity
 int dem_world_add_wall(dem_world *w, const dem_wall_def *def);
 /// Change a wall's spin (rad/s), e.g. to start a drum turning.
 dem_status dem_world_set_wall_spin(dem_world *w, int wall, double spin);
-/// Prescribed wall motion: move a wall's reference point (a plane's point, a
-/// disc's centre, a point on a cylinder's axis) to `point`, e.g. before every
-/// step (a piston driven at a set speed). The step in progress ends with the
+/// Place a wall: move its reference point (a plane's point, a disc's centre,
+/// a point on a cylinder's axis) to `point` (a piston set on a bed before it
+/// is driven; a wall driven at a set speed is given its prescribed motion,
+/// dem_world_set_wall_translation, instead). The step in progress ends with the
 /// forces already computed; the next force evaluation sees the wall where it
 /// now is, with its surface moving at its spin and its velocity
 /// (dem_world_set_wall_velocity) only: the move itself enters no relative
@@ -164,13 +199,22 @@ dem_status dem_world_set_wall_spin(dem_world *w, int wall, double spin);
 /// at. The lists are rebuilt once a wall has moved half a skin since they
 /// were built.
 dem_status dem_world_set_wall_point(dem_world *w, int wall, dem_vec3 point);
-/// Prescribed wall motion: the wall's translational velocity (m/s), which the
-/// contact law sees as the wall surface's velocity (with the spin's); e.g. a
-/// piston's drive speed, or a conveyor plane moving along itself. The wall is
-/// not moved by it (dem_world_set_wall_point). A wall whose velocity is zero
+/// The wall's translational velocity (m/s), which the contact law sees as the
+/// wall surface's velocity (with the spin's); e.g. a conveyor plane moving
+/// along itself. The wall is not moved by it unless it translates
+/// (dem_wall_def.motion; then the step displacement (0, 0, 0) follows the new
+/// velocity). A wall whose velocity is zero
 /// adds nothing to the relative velocity, so its results are those of a wall
 /// without the field, bit for bit.
 dem_status dem_world_set_wall_velocity(dem_world *w, int wall, dem_vec3 velocity);
+/// Prescribed wall motion in the engine (dem_wall_def.motion): from now on
+/// the wall translates, moved by `step_displacement` before every step
+/// ((0, 0, 0): velocity × dt), its surface moving at `velocity` in the
+/// contacts; a multi-step call (dem_world_step) drives it on every thread.
+/// Set again for a new leg (a piston reversing).
+dem_status dem_world_set_wall_translation(dem_world *w, int wall, dem_vec3 velocity, dem_vec3 step_displacement);
+/// The wall stands where it is: no prescribed motion, velocity zero.
+dem_status dem_world_stop_wall(dem_world *w, int wall);
 /// A wall's definition as it now is (point and spin included); NULL for no
 /// such wall.
 const dem_wall_def *dem_world_wall(const dem_world *w, int wall);
@@ -218,7 +262,25 @@ typedef struct dem_network_dt_check {
 /// A world whose neighbour list is not built yet is not checked (margin NAN).
 dem_status dem_world_check_network_dt(dem_world *w, dem_network_dt_check *out);
 
-/// Advance `steps` time steps. Stops early with a status on a fault (NaN,
+/// What the world's own network checks (dem_world_def.network_check_interval)
+/// found since the interval was last set.
+typedef struct dem_network_checks {
+    uint64_t checks;   ///< checks made
+    uint64_t lowered;  ///< of them, those that lowered the step
+    double margin_min; ///< the least margin seen (dem_network_dt_check.margin); NAN: none measured
+    double wall_s;     ///< wall-clock seconds spent in the checks (timing only)
+} dem_network_checks;
+
+/// Set the world's network checks (dem_world_def.network_check_interval and
+/// network_check_chunk; 0: off) from now on: the count of steps to the next
+/// check and dem_world_network_checks start afresh. DEM_ERR_INVALID for a
+/// negative or non-finite value.
+dem_status dem_world_set_network_check(dem_world *w, double interval, double chunk);
+dem_network_checks dem_world_network_checks(const dem_world *w);
+
+/// Advance `steps` time steps, the walls moved by their prescribed motion and
+/// the step checked against the network at the world's interval (which may
+/// lower dt within the call). Stops early with a status on a fault (NaN,
 /// escaped granule); the state at the fault is kept for inspection.
 dem_status dem_world_step(dem_world *w, uint64_t steps);
 

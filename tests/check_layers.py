@@ -94,11 +94,7 @@ ARROWS = {
 
 # Includes known to break a rule and being removed: (file, header) -> why it is
 # still there. Reported, not failed on; a line that is gone is reported too.
-KNOWN_INCLUDES = {
-    ("experiments/compress/exp_compress.c", "exp_scene.h"): (
-        "unused since the located-error helpers moved to exp_yaml.h (issue 38); exp_compress.c is being "
-        "rewritten on another branch, so the line goes with that change"),
-}
+KNOWN_INCLUDES = {}
 
 
 def module_of(name):

@@ -17,7 +17,6 @@
 #include "exp_plot.h"
 #include "exp_pour.h"
 #include "exp_result.h"
-#include "exp_scene.h"
 #include "exp_yaml.h"
 
 #define FILL_GRAVITY 30.0 // pour and settle under 30 g (see exp_compress_run)
@@ -118,19 +117,32 @@ static dem_world *create_die(const exp_compress_def *d, double gravity, char *er
     return w;
 }
 
-// The piston's height: its prescribed position, moved before every step.
+// The piston's height: its prescribed position, moved by the engine before
+// every step (drive_piston).
 static double piston_y(const dem_world *w) { return dem_world_wall(w, WALL_PISTON)->point.y; }
 
 // Place the piston at height y, its surface moving at vy (m/s, along the
-// die's axis): the speed it is driven at, so that its contacts' dashpots and
-// friction see the relative velocity of granule and piston (a move alone is
-// not seen by the contact law). 0 where it is placed rather than driven.
+// die's axis): 0, where it is placed rather than driven (drive_piston).
 static dem_status move_piston(dem_world *w, double y, double vy)
 {
     dem_vec3 p = dem_world_wall(w, WALL_PISTON)->point;
     p.y = y;
     dem_status st = dem_world_set_wall_point(w, WALL_PISTON, p);
     return st != DEM_OK ? st : dem_world_set_wall_velocity(w, WALL_PISTON, dem_v3(0, vy, 0));
+}
+
+// Drive the piston from where it stands, down while loading: the engine
+// moves it by `travel` before every step (the wall's prescribed motion,
+// dem_world_set_wall_translation), its surface at `speed`, so that its
+// contacts' dashpots and friction see the relative velocity of granule and
+// piston (a move alone is not seen by the contact law). `travel` is this
+// file's own product (speed × dt, times the approach factor), handed over as
+// it is, and the engine adds it as this loop once did step by step
+// (y += ±travel): the piston's heights are the same bits.
+static dem_status drive_piston(dem_world *w, int loading, double travel, double speed)
+{
+    return dem_world_set_wall_translation(w, WALL_PISTON, dem_v3(0, loading ? -speed : speed, 0),
+                                          dem_v3(0, loading ? -travel : travel, 0));
 }
 
 // Spring forces on the piston, the floor and the side wall: the normal
@@ -233,11 +245,11 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         // quarter of σ_min (the Instron's approach), then at the test speed.
         double travel = approaching ? APPROACH_FACTOR * step_travel : step_travel;
         const double speed = (approaching ? APPROACH_FACTOR : 1.0) * d->piston_speed;
-        for (uint64_t s = 0; s < per_sample; ++s) {
-            y += loading ? -travel : travel;
-            if (move_piston(w, y, loading ? -speed : speed) != DEM_OK || dem_world_step(w, 1) != DEM_OK)
-                return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
-        }
+        // One sample's steps in one call: the engine moves the piston and
+        // steps on its threads.
+        if (drive_piston(w, loading, travel, speed) != DEM_OK || dem_world_step(w, per_sample) != DEM_OK)
+            return free(c.s), exp_fail(err, len, "%s", dem_world_error(w));
+        y = piston_y(w);
         steps += per_sample;
         exp_compress_sample sm = {0};
         sm.t = dem_world_time(w) - t0;
@@ -283,7 +295,7 @@ static int cycle_piston(dem_world *w, const exp_compress_def *d, exp_progress_fn
         if (progress) progress(loading ? "load" : "unload", sm.t, dem_world_granules(w).count, ctx);
         if (sm.t > d->max_time) break;
     }
-    move_piston(w, y, 0.0); // the test is over: the piston stops where it is
+    dem_world_stop_wall(w, WALL_PISTON); // the test is over: the piston stops where it is
     out->curve = c.s, out->n_curve = c.n;
     out->bed_height = h0;
     out->particle_steps = steps * dem_world_granules(w).count;

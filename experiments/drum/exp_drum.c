@@ -337,9 +337,7 @@ enum {
     TURN_START_TILT,
     TURN_STEADY_FROM,
     TURN_STEADY_AT,
-    TURN_DT_MARGIN, // the network checks so far: a resumed run reports the whole run's
-    TURN_DT_LOWERED,
-    TURN_DOUBLES
+    TURN_DOUBLES // (the network checks so far are the world's: dem_world_network_checks)
 };
 _Static_assert(sizeof(exp_drum_measure) == MEASURE_DOUBLES * sizeof(double), "a measurement is saved as 4 doubles");
 
@@ -350,7 +348,6 @@ static int save_turn(const dem_world *w, const exp_drum_run_opts *o, const turn_
     turn[TURN_T0] = s->t0, turn[TURN_STEPS] = (double)s->steps, turn[TURN_WALL_S] = s->earlier_wall_s + wall_s;
     turn[TURN_START_TILT] = o->start_tilt_deg;
     turn[TURN_STEADY_FROM] = s->steady_from, turn[TURN_STEADY_AT] = s->steady_at;
-    turn[TURN_DT_MARGIN] = out->dt_margin_min, turn[TURN_DT_LOWERED] = out->dt_lowered;
     dem_checkpoint_array extra[2] = {{"turn", turn, TURN_DOUBLES},
                                      {"measurements", (double *)s->m, (size_t)s->count * MEASURE_DOUBLES}};
     return dem_checkpoint_write(w, o->checkpoint->path, o->checkpoint->key, extra, 2, err, len);
@@ -370,7 +367,6 @@ static int resume_turn(dem_world *w, const exp_drum_run_opts *o, turn_state *s, 
         s->t0 = turn[TURN_T0], s->steps = (uint64_t)turn[TURN_STEPS], s->earlier_wall_s = turn[TURN_WALL_S];
         out->start_tilt_deg = turn[TURN_START_TILT];
         s->steady_from = (int)turn[TURN_STEADY_FROM], s->steady_at = (int)turn[TURN_STEADY_AT];
-        out->dt_margin_min = turn[TURN_DT_MARGIN], out->dt_lowered = (int)turn[TURN_DT_LOWERED];
         s->count = (int)(extra[1].count / MEASURE_DOUBLES);
         memcpy(s->m, extra[1].data, extra[1].count * sizeof(double));
     } else if (rc != 1)
@@ -397,6 +393,14 @@ static dem_status start_turn(dem_world *w, const exp_drum_def *d, const exp_drum
     out->start_tilt_deg = o->start_tilt_deg;
     st = o->adopt_network_dt ? dem_world_adopt_network_dt(w) : dem_world_prepare(w);
     if (st != DEM_OK) return st;
+    // The engine re-checks the step itself, counted in samples (the chunks
+    // exp_drum_rotate steps in): each check at the end of a sample, every
+    // network_check_interval of turning, also after a lowered step. The
+    // schedule is the world's, so a resumed run (its checkpoint) checks on
+    // where it would have.
+    st = dem_world_set_network_check(w, o->network_check_interval > 0 ? o->network_check_interval : 0,
+                                     o->sample_interval);
+    if (st != DEM_OK) return st;
     // The end plates are part of the drum and turn with it (walls 1 and 2
     // of a full drum; they stood still before, dragging the bed's faces).
     for (int k = 0; k < (d->periodic ? 1 : 3); ++k) dem_world_set_wall_spin(w, k, o->rpm * 2.0 * DEM_PI / 60.0);
@@ -404,22 +408,13 @@ static dem_status start_turn(dem_world *w, const exp_drum_def *d, const exp_drum
     return DEM_OK;
 }
 
-// Every network_check_interval of turning (counted in samples, which a
-// resumed run counts on from its checkpoint: the checks fall where they would
-// have), the step against the bed's network now; a lowered step changes the
-// steps per sample (*chunk).
-static dem_status check_step(dem_world *w, const exp_drum_run_opts *o, int samples, uint64_t *chunk,
-                             exp_drum_result *out)
+// What the world's network checks found (dem_world_network_checks: the whole
+// run's, a resumed one's included), and the wall time of this call's own.
+static void report_checks(const dem_world *w, double wall_before, exp_drum_result *out)
 {
-    int every = (int)(o->network_check_interval / o->sample_interval + 0.5);
-    if (!(o->network_check_interval > 0) || samples % (every > 0 ? every : 1) != 0) return DEM_OK;
-    double t0 = exp_wall_seconds();
-    dem_network_dt_check c;
-    dem_status st = dem_world_check_network_dt(w, &c);
-    out->network_check_wall_s += exp_wall_seconds() - t0;
-    if (!isnan(c.margin)) out->dt_margin_min = isnan(out->dt_margin_min) ? c.margin : fmin(out->dt_margin_min, c.margin);
-    if (c.lowered) out->dt_lowered++, *chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
-    return st;
+    const dem_network_checks c = dem_world_network_checks(w);
+    out->dt_margin_min = c.margin_min, out->dt_lowered = (int)c.lowered;
+    out->network_check_wall_s = c.wall_s - wall_before;
 }
 
 dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_run_opts *o, exp_progress_fn progress,
@@ -436,20 +431,25 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     dem_status st = out->resumed ? DEM_OK : start_turn(w, d, o, &s, out);
     if (st != DEM_OK) return free(s.m), st;
     out->earlier_wall_s = s.earlier_wall_s;
-    uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
+    const double check_wall_before = dem_world_network_checks(w).wall_s;
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
     while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval &&
            !(s.steady_from >= 0 && s.count - s.steady_at >= avg_samples)) {
+        // One sample's steps at the step now in use: a network check (the
+        // engine's, at the end of a sample) may have lowered it.
+        const uint64_t chunk = (uint64_t)(o->sample_interval / dem_world_dt(w) + 0.5);
         st = dem_world_step(w, chunk);
         s.steps += chunk;
-        if (st != DEM_OK) break;
+        // DEM_ERR_UNSTABLE: the check at the sample's end refused a
+        // configured step, after the steps; the sample is still measured.
+        if (st != DEM_OK && st != DEM_ERR_UNSTABLE) break;
         double measure_start = exp_wall_seconds();
         int unmeasured = exp_drum_measure_now(w, d, pixel, d->closing_px, &s.m[s.count]);
         out->measure_wall_s += exp_wall_seconds() - measure_start;
         if (unmeasured) break;
         if (o->on_sample) o->on_sample(s.count, &s.m[s.count], o->sample_ctx);
         s.count++;
-        if ((st = check_step(w, o, s.count, &chunk, out)) != DEM_OK) break;
+        if (st != DEM_OK) break;
         if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
             s.steady_from = s.count - 2 * per_window, s.steady_at = s.count;
         if (progress) progress("turn", dem_world_time(w) - s.t0, dem_world_granules(w).count, ctx);
@@ -465,6 +465,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     // averaged (a slumping bed's saw-tooth makes one window's mean depend on
     // where in an avalanche cycle it starts), and so is every sample after
     // them (average_time). Not steady: the last two windows.
+    report_checks(w, check_wall_before, out);
     out->steady = s.steady_from >= 0;
     int from = out->steady ? s.steady_from : s.count > 2 * per_window ? s.count - 2 * per_window : 0;
     out->averaged_time_s = (s.count - from) * o->sample_interval;

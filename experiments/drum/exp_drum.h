@@ -141,8 +141,9 @@ typedef struct exp_drum_run_opts {
     double csa_tol_percent; ///< ... and of the CSA within this (0.5 %) + half their mean sd
     int adopt_network_dt;   ///< turn at the settled bed's own network step limit (1)
     /// s of turning between checks of the step against the turning bed's
-    /// own network (dem_world_check_network_dt; 0: never). A check reads the
-    /// bed only, so a run whose step stays within the limit is the same run.
+    /// own network (0: never), counted in samples: the world's own checks
+    /// (dem_world_set_network_check). A check reads the bed only, so a run
+    /// whose step stays within the limit is the same run.
     double network_check_interval;
     /// The settled bed is first turned rigidly by this angle about the drum
     /// axis, in the drum's sense (20°): as if the drum had already turned it,
