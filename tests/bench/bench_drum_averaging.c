@@ -15,6 +15,8 @@
 //    tier's average_time (a run's trajectory does not depend on when it stops, so the record is still
 //    checked, against the mean over the tier's own averaging); it also prints the mean of each 2 s block
 //    after the steady test, which shows a drift the running mean smooths.
+//   With SERIES_CSV=FILE set, every sample is also written there (seconds turned, angle, CSA), so that a
+//   rule for the transient or the averaging can be tried on the series without turning the bed again.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +46,17 @@ static void keep(int index, const exp_drum_measure *m, void *ctx)
 
 // Samples in t seconds of turning, rounded as exp_drum.c counts its windows.
 static int samples_in(const exp_drum_run_opts *o, double t) { return (int)(t / o->sample_interval + 0.5); }
+
+// Every sample, one line each: seconds turned at the sample's end, angle (°), CSA (%).
+static int write_series(const char *path, const series *s, double sample_interval)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return fprintf(stderr, "%s: cannot write\n", path), 1;
+    fprintf(f, "t_s,angle_deg,csa_percent\n");
+    for (int i = 0; i < s->n; ++i)
+        fprintf(f, "%.4f,%.17g,%.17g\n", (i + 1) * sample_interval, s->m[i].angle_deg, s->m[i].csa_percent);
+    return fclose(f) != 0;
+}
 
 static void mean_over(const series *s, int from, int to, double *angle, double *csa)
 {
@@ -110,10 +123,12 @@ int main(int argc, char **argv)
         printf("block_from_s=%.2f block_to_s=%.2f angle_deg=%.4f csa_percent=%.4f\n", b0 * o.sample_interval,
                (b0 + block) * o.sample_interval, angle, csa);
     }
+    const char *series_path = getenv("SERIES_CSV");
+    const int unwritten = series_path && write_series(series_path, &s, o.sample_interval);
     free(list), free(s.m);
     cal_record_free(&rec);
     if (w != bed) dem_world_destroy(w);
     dem_world_destroy(bed);
     cal_config_free(c);
-    return 0;
+    return unwritten;
 }
