@@ -44,6 +44,9 @@ static const cyaml_schema_field_t tier_fields[] = {
     TIER_FLOAT("steady_csa_tol_percent", steady_csa_tol_percent, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_STRING_PTR("fill_method", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, fill_method, 1, 16),
     TIER_FLOAT("average_time", average_time, CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_STRING_PTR("steady_rule", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, steady_rule, 1, 16),
+    TIER_FLOAT("steady_se_angle_deg", steady_se_angle_deg, CYAML_FLAG_OPTIONAL),
+    TIER_FLOAT("steady_se_csa_percent", steady_se_csa_percent, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_SEQUENCE("average_time_per_rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, average_time_per_rpm,
                          &float_entry, 1, 32),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
@@ -165,10 +168,31 @@ static int block_of(const cal_config *c, const char *name)
     return 1;
 }
 
+// The MSER rule stops a run itself: its two targets, and no averaging time.
+static int check_steady_rule(const cal_config *c, int from, const cal_tier *t, char *err, size_t len)
+{
+    int rule = EXP_STEADY_WINDOWS;
+    if (t->steady_rule && exp_drum_steady_rule_from_name(t->steady_rule, &rule))
+        return located(c, from, "steady_rule", err, len, "'%s': use windows or mser", t->steady_rule);
+    if (rule != EXP_STEADY_MSER) {
+        if (t->steady_se_angle_deg != 0 || t->steady_se_csa_percent != 0)
+            return located(c, from, "steady_se_angle_deg", err, len, "the standard error targets need steady_rule: mser");
+        return 0;
+    }
+    if (bad_positive(t->steady_se_angle_deg) || bad_positive(t->steady_se_csa_percent))
+        return located(c, from, "steady_se_angle_deg", err, len,
+                       "steady_rule mser needs steady_se_angle_deg and steady_se_csa_percent > 0 (got %g, %g)",
+                       t->steady_se_angle_deg, t->steady_se_csa_percent);
+    if (t->average_time > 0 || t->average_time_per_rpm_count > 0)
+        return located(c, from, "steady_rule", err, len, "mser stops each run itself: give no average_time");
+    return 0;
+}
+
 // The drum's knobs, a tier's or a rung's; sample_interval and the steady
 // test's tolerances are optional (0 or absent: the drum's default).
 static int check_drum_knobs(const cal_config *c, int from, const cal_tier *t, char *err, size_t len)
 {
+    if (check_steady_rule(c, from, t, err, len)) return 1;
     if (!(isfinite(t->average_time) && t->average_time >= 0 && 2 * t->window + t->average_time <= t->max_time))
         return located(c, from, "average_time", err, len, "%g must be >= 0 and fit with two windows (%g s) in max_time (%g s)",
                        t->average_time, 2 * t->window, t->max_time);
@@ -339,7 +363,8 @@ static int check_fidelity(const cal_config *c, char *err, size_t len)
         if (tier_key)
             return located(c, block_of(c, r->name), tier_key, err, len, "a key of a calibration tier: a rung takes the "
                            "drum's (lambda, slice_depth, max_time, window, sample_interval, steady_angle_tol_deg, "
-                           "steady_csa_tol_percent, fill_method, average_time); the study's speeds are fidelity.rpm");
+                           "steady_csa_tol_percent, fill_method, average_time, steady_rule, steady_se_angle_deg, "
+                           "steady_se_csa_percent); the study's speeds are fidelity.rpm");
         if (check_drum_knobs(c, block_of(c, r->name), r, err, len)) return 1;
     }
     return 0;

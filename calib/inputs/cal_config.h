@@ -40,6 +40,12 @@ typedef struct cal_tier {
     double steady_angle_tol_deg, steady_csa_tol_percent; ///< optional; 0: the drum's defaults
     char *fill_method;      ///< how the drum's bed is built: "pour" (absent) or "pack" (exp_drum_fill_method)
     double average_time;    ///< s averaged on after the steady test holds (exp_drum_run_opts; 0: none)
+    /// How a run decides it is steady and stops: "windows" (absent: the two
+    /// windows' test, then the averaging) or "mser" (exp_drum_run_opts.
+    /// steady_rule: MSER's cut and a standard error of at most
+    /// steady_se_angle_deg and steady_se_csa_percent, both then required).
+    char *steady_rule;
+    double steady_se_angle_deg, steady_se_csa_percent;
     // A calibration tier's alone (optional in the schema, so that a rung
     // reads without them; check_tier requires cylinder_lambda and seeds):
     /// The same, one per entry of rpm (replaces average_time): a slow drum

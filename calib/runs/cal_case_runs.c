@@ -51,6 +51,8 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     if (t->sample_interval > 0) d.run.sample_interval = t->sample_interval;
     if (t->steady_angle_tol_deg > 0) d.run.angle_tol_deg = t->steady_angle_tol_deg;
     if (t->steady_csa_tol_percent > 0) d.run.csa_tol_percent = t->steady_csa_tol_percent;
+    if (t->steady_rule) exp_drum_steady_rule_from_name(t->steady_rule, &d.run.steady_rule); // checked on loading
+    d.run.se_angle_deg = t->steady_se_angle_deg, d.run.se_csa_percent = t->steady_se_csa_percent;
     d.fill = d.def;
     return d;
 }
@@ -150,6 +152,8 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
              r->angle_tol_deg, r->csa_tol_percent, r->adopt_network_dt, r->start_tilt_deg);
     // Named only when set, so that every record stored before it keeps its key.
     if (r->average_time > 0) snprintf(out + strlen(out), len - strlen(out), " average_time=%.10g", r->average_time);
+    if (r->steady_rule == EXP_STEADY_MSER)
+        snprintf(out + strlen(out), len - strlen(out), " steady=mser se=%.10g,%.10g", r->se_angle_deg, r->se_csa_percent);
 }
 
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)

@@ -12,6 +12,7 @@
 #include "exp_contact_rules.h"
 #include "exp_cost.h"
 #include "exp_pour.h"
+#include "exp_series.h"
 
 #define LAYER_MAX_TIME 0.6     // s a poured layer may take to land
 #define LAYER_KE_RATIO 1e-2    // a layer has landed below this KE over (bed mass)·g·d50
@@ -128,6 +129,13 @@ int exp_drum_fill_method_from_name(const char *name, exp_drum_fill_method *out)
 }
 
 const char *exp_drum_fill_method_name(exp_drum_fill_method m) { return m == EXP_FILL_PACK ? "pack" : "pour"; }
+
+int exp_drum_steady_rule_from_name(const char *name, int *out)
+{
+    if (strcmp(name, "windows") == 0) return *out = EXP_STEADY_WINDOWS, 0;
+    if (strcmp(name, "mser") == 0) return *out = EXP_STEADY_MSER, 0;
+    return 1;
+}
 
 double exp_drum_fill_level(double r, double fill)
 {
@@ -317,6 +325,31 @@ static int is_steady(const exp_drum_measure *m, int count, int per_window, const
     return fabs(a.mean_angle - b.mean_angle) <= angle_tol && fabs(a.mean_csa - b.mean_csa) <= csa_tol;
 }
 
+// MSER's batch (samples) and the batches of the standard error: a batch of
+// 10 % of the span kept, ~1 s at 4 rpm for a 10 s mean, an avalanche cycle.
+enum { MSER_BATCH = 5, SE_BATCHES = 10 };
+
+// The MSER rule (EXP_STEADY_MSER): whether the run may stop, and then where
+// its mean starts (*from, untouched otherwise). `scratch`: 2 * count doubles.
+static int mser_steady(const exp_drum_measure *m, int count, int per_window, const exp_drum_run_opts *o,
+                       double *scratch, int *from)
+{
+    if (count < 2 * per_window) return 0;
+    double *angle = scratch, *csa = scratch + count;
+    for (int k = 0; k < count; ++k) angle[k] = m[k].angle_deg, csa[k] = m[k].csa_percent;
+    int angle_at_limit, csa_at_limit;
+    const int angle_from = exp_series_mser_start(angle, count, MSER_BATCH, &angle_at_limit);
+    const int csa_from = exp_series_mser_start(csa, count, MSER_BATCH, &csa_at_limit);
+    if (angle_from < 0 || csa_from < 0 || angle_at_limit || csa_at_limit) return 0;
+    const int start = angle_from > csa_from ? angle_from : csa_from;
+    if (count - start < 2 * per_window) return 0; // at least the windows' test's span averaged
+    if (exp_series_batch_se(angle + start, count - start, SE_BATCHES) > o->se_angle_deg ||
+        exp_series_batch_se(csa + start, count - start, SE_BATCHES) > o->se_csa_percent)
+        return 0;
+    *from = start;
+    return 1;
+}
+
 // Everything of a rotation run that is not the world: what a checkpoint
 // saves beside it.
 typedef struct turn_state {
@@ -425,11 +458,14 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     int per_window = (int)(o->window / o->sample_interval + 0.5);
     int avg_samples = (int)(o->average_time / o->sample_interval + 0.5);
     turn_state s = {.cap = (int)(o->max_time / o->sample_interval) + 2, .steady_from = -1};
+    const int mser = o->steady_rule == EXP_STEADY_MSER;
+    if (mser) avg_samples = 0; // the rule stops the run itself
     s.m = malloc((size_t)s.cap * sizeof *s.m);
-    if (!s.m) return DEM_ERR_NOMEM;
+    double *scratch = mser ? malloc(2 * (size_t)s.cap * sizeof *scratch) : NULL;
+    if (!s.m || (mser && !scratch)) return free(s.m), free(scratch), DEM_ERR_NOMEM;
     out->resumed = o->checkpoint && resume_turn(w, o, &s, out);
     dem_status st = out->resumed ? DEM_OK : start_turn(w, d, o, &s, out);
-    if (st != DEM_OK) return free(s.m), st;
+    if (st != DEM_OK) return free(s.m), free(scratch), st;
     out->earlier_wall_s = s.earlier_wall_s;
     const double check_wall_before = dem_world_network_checks(w).wall_s;
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
@@ -450,7 +486,9 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
         if (o->on_sample) o->on_sample(s.count, &s.m[s.count], o->sample_ctx);
         s.count++;
         if (st != DEM_OK) break;
-        if (s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
+        if (mser && s.steady_from < 0 && mser_steady(s.m, s.count, per_window, o, scratch, &s.steady_from))
+            s.steady_at = s.count;
+        else if (!mser && s.steady_from < 0 && is_steady(s.m, s.count, per_window, o))
             s.steady_from = s.count - 2 * per_window, s.steady_at = s.count;
         if (progress) progress("turn", dem_world_time(w) - s.t0, dem_world_granules(w).count, ctx);
         double now = exp_wall_seconds();
@@ -464,13 +502,14 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     // The two windows the steady test compared are one state: both are
     // averaged (a slumping bed's saw-tooth makes one window's mean depend on
     // where in an avalanche cycle it starts), and so is every sample after
-    // them (average_time). Not steady: the last two windows.
+    // them (average_time); under the MSER rule, every sample from its start.
+    // Not steady: the last two windows.
     report_checks(w, check_wall_before, out);
     out->steady = s.steady_from >= 0;
     int from = out->steady ? s.steady_from : s.count > 2 * per_window ? s.count - 2 * per_window : 0;
     out->averaged_time_s = (s.count - from) * o->sample_interval;
     window_stats ws = s.count ? stats_of(s.m, from, s.count) : (window_stats){NAN, NAN, NAN, NAN, NAN};
-    free(s.m);
+    free(s.m), free(scratch);
     out->angle_deg = ws.mean_angle, out->angle_sd_deg = ws.sd_angle;
     out->csa_percent = ws.mean_csa, out->csa_sd_percent = ws.sd_csa, out->fit_sd_m = ws.mean_fit;
     out->simulated_time_s = dem_world_time(w) - s.t0;

@@ -132,6 +132,12 @@ typedef struct exp_drum_checkpoint {
 } exp_drum_checkpoint;
 
 /// How a rotation run decides it is done.
+/// exp_drum_run_opts.steady_rule.
+enum { EXP_STEADY_WINDOWS = 0, EXP_STEADY_MSER = 1 };
+
+/// "windows" or "mser" to EXP_STEADY_*: 0, or 1 for another name.
+int exp_drum_steady_rule_from_name(const char *name, int *out);
+
 typedef struct exp_drum_run_opts {
     double rpm;
     double max_time;        ///< s of turning at most (the paper: 6 s)
@@ -156,6 +162,20 @@ typedef struct exp_drum_run_opts {
     /// run's mean over two windows carries a few avalanches' noise; a study
     /// that needs the mean to a given error averages longer.
     double average_time;
+    /// How the run decides that its transient is over and its mean known.
+    /// EXP_STEADY_WINDOWS (0): the two windows' test above, then average_time.
+    /// EXP_STEADY_MSER: after each sample, MSER-5 on the angle series and on
+    /// the CSA series (experiments/common/exp_series.h) says where each one's
+    /// steady part starts; the run stops once neither start lies at MSER's
+    /// limit (half the samples so far: the transient may go on) and the
+    /// batch-means standard errors of both means from the later start are
+    /// within se_angle_deg and se_csa_percent. The result is the mean from that
+    /// start; average_time is not used. Why: the windows' test holds on a 4 rpm
+    /// bed that is still compacting, and its mean carries ~1° of the transient
+    /// (results/benchmarks/long_turn.md); this rule cuts what the series shows
+    /// as transient and stops at a stated precision instead of a fixed time.
+    int steady_rule;
+    double se_angle_deg, se_csa_percent;
     /// NULL: no checkpoints. Not part of what defines a run: a run resumed
     /// from its checkpoints ends as the same run uninterrupted would.
     const exp_drum_checkpoint *checkpoint;

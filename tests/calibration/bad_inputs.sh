@@ -53,6 +53,9 @@ expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perh
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
 expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm 's/^    max_time: 1.5/    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
+expect "unknown steady rule" "steady_rule: 'eyeball': use windows or mser" -- "$(edit steady 's/^    max_time: 1.5/    max_time: 1.5\n    steady_rule: eyeball/')" "${out[@]}"
+expect "mser without its targets" "steady_rule mser needs steady_se_angle_deg and steady_se_csa_percent > 0 (got 0.2, 0)" -- "$(edit mser_se 's/^    max_time: 1.5/    max_time: 1.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2/')" "${out[@]}"
+expect "mser with an averaging time" "steady_rule: mser stops each run itself: give no average_time" -- "$(edit mser_avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 0.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2\n    steady_se_csa_percent: 0.1/')" "${out[@]}"
 # A tier the user asked for names the option, the file and the tiers it has; one the file names, its line.
 tiers=$(sed -n 's/^  - name: \(.*\)/\1/p' "$work/configs/good.yaml" | paste -sd, | sed 's/,/, /g')
 expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"

@@ -4,7 +4,10 @@
 // grows at the drum's angular velocity (4 rpm = 24°/s) — an independent,
 // kinematic check of the rotating wall, the measurement and the units. The
 // start tilt turns the bed the same way, by its angle. Checking the turn's
-// step against the bed's network leaves the run as it is.
+// step against the bed's network leaves the run as it is. The MSER rule stops
+// a run at the first sample where its own statement holds, and reports the
+// mean from the start it names.
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +18,7 @@
 #include <cmocka.h>
 
 #include "exp_drum_config.h"
+#include "exp_series.h"
 
 static void test_fill_and_rigid_turn(void **state)
 {
@@ -118,9 +122,81 @@ static void test_network_checks_leave_the_run(void **state)
     exp_drum_config_free(y);
 }
 
+typedef struct samples {
+    int n;
+    double angle[512], csa[512];
+} samples;
+
+static void keep_sample(int index, const exp_drum_measure *m, void *ctx)
+{
+    samples *s = ctx;
+    if (index < 512) s->angle[index] = m->angle_deg, s->csa[index] = m->csa_percent, s->n = index + 1;
+}
+
+// The rule's statement over the first n samples (exp_drum.h, EXP_STEADY_MSER:
+// MSER-5, 10 batches, at least two windows averaged): the start, or -1.
+static int rule_holds(const samples *s, int n, int per_window, const exp_drum_run_opts *o)
+{
+    if (n < 2 * per_window) return -1;
+    int la, lc;
+    const int a = exp_series_mser_start(s->angle, n, 5, &la), c = exp_series_mser_start(s->csa, n, 5, &lc);
+    if (a < 0 || c < 0 || la || lc) return -1;
+    const int start = a > c ? a : c;
+    if (n - start < 2 * per_window) return -1;
+    const int ok = exp_series_batch_se(s->angle + start, n - start, 10) <= o->se_angle_deg &&
+                   exp_series_batch_se(s->csa + start, n - start, 10) <= o->se_csa_percent;
+    return ok ? start : -1;
+}
+
+static void test_mser_rule_stops_where_it_says(void **state)
+{
+    (void)state;
+    char path[1024], err[512];
+    const char *src = getenv("GRANUCAL_SOURCE_DIR");
+    snprintf(path, sizeof path, "%s/configs/drum.yaml", src ? src : ".");
+    char *sets[] = {"lambda=65536", "slice_depth=0.04"};
+    exp_drum_yaml *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
+    if (!y) fail_msg("%s", err);
+    exp_drum_def d;
+    exp_drum_run_opts run;
+    assert_int_equal(exp_drum_config_defs(y, &d, &run, err, sizeof err), 0);
+    dem_world *bed = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
+    if (!bed) fail_msg("%s", err);
+    run.rpm = 40, run.max_time = 4.0, run.window = 0.25, run.average_time = 0;
+    run.steady_rule = EXP_STEADY_MSER, run.se_angle_deg = 1.0, run.se_csa_percent = 0.5;
+    const int per_window = (int)(run.window / run.sample_interval + 0.5);
+    for (int reachable = 1; reachable >= 0; --reachable) {
+        if (!reachable) run.se_angle_deg = 1e-6; // no run this short knows its angle that well
+        samples s = {0};
+        run.on_sample = keep_sample, run.sample_ctx = &s;
+        dem_world *w = dem_world_clone(bed);
+        assert_non_null(w);
+        exp_drum_result r;
+        assert_int_equal(exp_drum_rotate(w, &d, &run, NULL, NULL, &r), DEM_OK);
+        dem_world_destroy(w);
+        printf("MSER rule, angle target %g: %d samples, steady %d, angle %.3f over the last %.2f s\n", run.se_angle_deg,
+               s.n, r.steady, r.angle_deg, r.averaged_time_s);
+        assert_int_equal(r.steady, reachable);
+        for (int n = 1; n < s.n; ++n) assert_int_equal(rule_holds(&s, n, per_window, &run), -1); // not before
+        if (!reachable) {
+            assert_true(s.n * run.sample_interval > run.max_time - run.sample_interval); // turned to the end
+            continue;
+        }
+        const int start = rule_holds(&s, s.n, per_window, &run);
+        assert_true(start >= 0);
+        assert_true(s.n * run.sample_interval < run.max_time - run.sample_interval); // stopped by the rule
+        assert_true(fabs(r.angle_deg - exp_series_mean(s.angle, start, s.n)) < 1e-9);
+        assert_true(fabs(r.csa_percent - exp_series_mean(s.csa, start, s.n)) < 1e-9);
+        assert_true(fabs(r.averaged_time_s - (s.n - start) * run.sample_interval) < 1e-9);
+    }
+    dem_world_destroy(bed);
+    exp_drum_config_free(y);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_fill_and_rigid_turn),
-                                       cmocka_unit_test(test_network_checks_leave_the_run)};
+                                       cmocka_unit_test(test_network_checks_leave_the_run),
+                                       cmocka_unit_test(test_mser_rule_stops_where_it_says)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
