@@ -9,7 +9,9 @@
 double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst)
 {
     exp_drum_run_opts o = cal_drum_run_opts(d, rpm);
-    if (worst) return o.max_time;
+    // The MSER rule stops when the run's own series says so: nothing before
+    // the run predicts when, so both figures take its bound.
+    if (worst || o.steady_rule == EXP_STEADY_MSER) return o.max_time;
     return fmin(o.max_time, 2 * o.window + o.average_time);
 }
 

@@ -33,7 +33,8 @@ typedef struct cal_plan {
 
 /// What a drum run's expected and worst-case figures assume (cal_plan_turn_time), as a plan prints it.
 #define CAL_PLAN_RUN_ASSUMPTION \
-    "expected: each run ends at the steady test's first chance (two windows, then its averaging); worst case: max_time."
+    "expected: each run ends at the steady test's first chance (two windows, then its averaging; under the MSER " \
+    "rule max_time, as nothing predicts its stop); worst case: max_time."
 
 /// Add plan p to a total, expected and worst case alike (runs, seconds; the
 /// largest memory).
@@ -41,7 +42,8 @@ void cal_plan_add(cal_plan *total, const cal_plan *p);
 
 /// Simulated seconds a drum run of case d turns at rpm: the worst case
 /// max_time; expected, the steady test's first chance (its two windows, then
-/// the averaging time), at most max_time. Every λ 1000 run of the committed
+/// the averaging time), at most max_time; under the MSER rule max_time in
+/// both, since the run's own series decides its stop. Every λ 1000 run of the committed
 /// standard calibration ended within 0.75 s of that (results/calibration-standard/
 /// simulations.csv: 10.05-10.75 s at 4 rpm, 4.0-4.1 s at 40 and 116).
 double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst);
