@@ -20,22 +20,31 @@
 #include "exp_drum_config.h"
 #include "exp_series.h"
 
-static void test_fill_and_rigid_turn(void **state)
+// The shipped drum config with lambda and slice_depth set, its definitions,
+// and its bed filled (the caller frees the config and the world).
+static dem_world *filled_drum(char *lambda, char *slice_depth, exp_drum_yaml **y, exp_drum_def *d, exp_drum_run_opts *run)
 {
-    (void)state;
     char path[1024], err[512];
     const char *src = getenv("GRANUCAL_SOURCE_DIR");
     snprintf(path, sizeof path, "%s/configs/drum.yaml", src ? src : ".");
+    char *sets[] = {lambda, slice_depth};
+    *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
+    if (!*y) fail_msg("%s", err);
+    if (exp_drum_config_defs(*y, d, run, err, sizeof err)) fail_msg("%s", err);
+    dem_world *w = exp_drum_fill(d, NULL, NULL, err, sizeof err);
+    if (!w) fail_msg("%s", err);
+    return w;
+}
+
+static void test_fill_and_rigid_turn(void **state)
+{
+    (void)state;
     // A coarser bed than the shipped config (~460 granules in 3D instead of ~1140): what is
     // checked here (the fill degree, a level bed, rigid turning) does not depend on lambda.
-    char *sets[] = {"lambda=16384", "slice_depth=0.025"};
-    exp_drum_yaml *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
-    if (!y) fail_msg("%s", err);
+    exp_drum_yaml *y;
     exp_drum_def d;
     exp_drum_run_opts run;
-    assert_int_equal(exp_drum_config_defs(y, &d, &run, err, sizeof err), 0);
-    dem_world *w = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
-    if (!w) fail_msg("%s", err);
+    dem_world *w = filled_drum("lambda=16384", "slice_depth=0.025", &y, &d, &run);
     double pixel = 0.25 * d.gsd.median_diameter * cbrt(d.lambda);
     exp_drum_measure m0, m1;
     assert_int_equal(exp_drum_measure_now(w, &d, pixel, d.closing_px, &m0), 0);
@@ -90,17 +99,10 @@ static void test_fill_and_rigid_turn(void **state)
 static void test_network_checks_leave_the_run(void **state)
 {
     (void)state;
-    char path[1024], err[512];
-    const char *src = getenv("GRANUCAL_SOURCE_DIR");
-    snprintf(path, sizeof path, "%s/configs/drum.yaml", src ? src : ".");
-    char *sets[] = {"lambda=65536", "slice_depth=0.04"};
-    exp_drum_yaml *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
-    if (!y) fail_msg("%s", err);
+    exp_drum_yaml *y;
     exp_drum_def d;
     exp_drum_run_opts run;
-    assert_int_equal(exp_drum_config_defs(y, &d, &run, err, sizeof err), 0);
-    dem_world *bed = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
-    if (!bed) fail_msg("%s", err);
+    dem_world *bed = filled_drum("lambda=65536", "slice_depth=0.04", &y, &d, &run);
     run.rpm = 40, run.max_time = 1.0, run.window = 0.25;
     exp_drum_result r[2];
     for (int checked = 0; checked < 2; ++checked) {
@@ -151,17 +153,10 @@ static int rule_holds(const samples *s, int n, int per_window, const exp_drum_ru
 static void test_mser_rule_stops_where_it_says(void **state)
 {
     (void)state;
-    char path[1024], err[512];
-    const char *src = getenv("GRANUCAL_SOURCE_DIR");
-    snprintf(path, sizeof path, "%s/configs/drum.yaml", src ? src : ".");
-    char *sets[] = {"lambda=65536", "slice_depth=0.04"};
-    exp_drum_yaml *y = exp_drum_config_load(path, 2, sets, err, sizeof err);
-    if (!y) fail_msg("%s", err);
+    exp_drum_yaml *y;
     exp_drum_def d;
     exp_drum_run_opts run;
-    assert_int_equal(exp_drum_config_defs(y, &d, &run, err, sizeof err), 0);
-    dem_world *bed = exp_drum_fill(&d, NULL, NULL, err, sizeof err);
-    if (!bed) fail_msg("%s", err);
+    dem_world *bed = filled_drum("lambda=65536", "slice_depth=0.04", &y, &d, &run);
     run.rpm = 40, run.max_time = 4.0, run.window = 0.25, run.average_time = 0;
     run.steady_rule = EXP_STEADY_MSER, run.se_angle_deg = 1.0, run.se_csa_percent = 0.5;
     const int per_window = (int)(run.window / run.sample_interval + 0.5);
