@@ -45,6 +45,10 @@ static const char synopsis[] =
     "whole search maps the plane, then this tier runs only where that map, corrected by\n"
     "the discrepancy measured between the two at those runs, puts the optimum, until a\n"
     "run agrees with the corrected map within the data's noise (max_evaluations runs).\n"
+    "Where NAME has a map_tier of its own, NAME's stage is itself two-tier (levels:\n"
+    "ci -> lambda 1000 -> lambda 512, the fine-levels tier): its runs and its corrected\n"
+    "map's predictions are the map of the level above, which corrects them only by the\n"
+    "discrepancy measured at its own runs.\n"
     "\n"
     "CONFIG defaults to configs/calibration.yaml; it names the lab data files\n"
     "(repose_angle.csv: surface,rpm,angle_deg,angle_sd_deg; occupied_area.csv:\n"
@@ -421,17 +425,18 @@ static void print_table(const char *dir)
     printf("\nresults: %s (report.md, calibrated_parameters.csv, plots)\n", dir);
 }
 
-// A friction stage's plan: with a map tier, the map's runs as a step of their
-// own ("NAME (map)", their own cost), then this tier's.
+// A friction stage's plan: with a map tier, each level's runs as a step of
+// their own, the deepest first as they run ("NAME (map 2)", "NAME (map)",
+// each with its own cost), then this tier's.
 static void plan_friction(run *r, const char *name, const cal_material *m)
 {
-    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
-    if (map) {
+    for (int level = cal_tier_map_depth(r->c, r->t); level >= 0; --level) {
+        const cal_tier *t = cal_tier_map_level(r->c, r->t, level);
         char label[64];
-        snprintf(label, sizeof label, "%.50s (map)", name);
-        cal_progress_plan(&r->progress, label, CAL_RUN_MAP_DRUM, cal_friction_planned_runs(r->c, map, &r->angles, &r->areas, m));
+        cal_progress_level_name(name, level, label, sizeof label);
+        cal_progress_plan(&r->progress, label, cal_progress_drum_kind(level),
+                          cal_friction_planned_runs(r->c, t, &r->angles, &r->areas, m));
     }
-    cal_progress_plan(&r->progress, name, CAL_RUN_DRUM, cal_friction_planned_runs(r->c, r->t, &r->angles, &r->areas, m));
 }
 
 // ---- the plan: expected and worst-case cost, before the first simulation ----------------
@@ -456,7 +461,7 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 // is new, and k_n is the stiffest stage 1 may choose. Both are the cost of the
 // whole calibration: records already in OUT/store are not subtracted.
 
-enum { PLAN_MAX_TIERS = 16, PLAN_MAX_STEPS = 2 * 16 + 3 }; // stage 1, granule and 16 walls, each with its map
+enum { PLAN_MAX_TIERS = 16, PLAN_MAX_STEPS = CAL_PROGRESS_MAX_STAGES }; // stage 1, granule and 16 walls, each at every level
 
 typedef struct plan_pass {
     int worst;
@@ -598,19 +603,21 @@ static cal_plan *plan_step(plan *p, const char *name, const char *what)
     return &p->step[p->n++];
 }
 
-// A friction stage's steps: with a map tier, the map's whole search ("NAME
-// (map)") then this tier's runs; else this tier's search.
+// A friction stage's steps: each level's, the deepest first as they run: the
+// deepest map tier's whole search ("NAME (map 2)"...), then each level above
+// deciding by its own runs ("NAME (map)", then NAME); a one-tier stage is
+// its search alone.
 static int plan_friction_steps(run *r, plan *p, plan_pass pass[2], const cal_material *m, const char *name)
 {
-    const cal_tier *map = r->t->map_tier ? cal_config_tier_named(r->c, r->t->map_tier) : NULL;
     char label[64], what[64];
-    for (int step = map ? 0 : 1; step < 2; ++step) {
-        const cal_tier *t = step ? r->t : map;
-        snprintf(label, sizeof label, step ? "%.50s" : "%.50s (map)", name);
+    for (int level = cal_tier_map_depth(r->c, r->t); level >= 0; --level) {
+        const cal_tier *t = cal_tier_map_level(r->c, r->t, level);
+        cal_progress_level_name(name, level, label, sizeof label);
         snprintf(what, sizeof what, "drum runs at tier '%.31s'", t->name);
         cal_plan *c = plan_step(p, label, what);
         for (int w = 0; w < 2; ++w)
-            if (plan_search(r, &pass[w], t, m, step && map, w ? &c->worst : &c->expected, r->err, sizeof r->err)) return 1;
+            if (plan_search(r, &pass[w], t, m, t->map_tier != NULL, w ? &c->worst : &c->expected, r->err, sizeof r->err))
+                return 1;
     }
     return 0;
 }
@@ -639,11 +646,13 @@ static void print_plan(const run *r, const plan *p)
 {
     int parallel = r->env.workers * cal_mpi_size();
     fprintf(stderr, "== plan: tier '%s', %d worker(s); expected (worst case)\n", r->t->name, parallel);
+    int what = 28; // widened where a tier's name is long, so the columns stay aligned
+    for (int k = 0; k < p->n; ++k) what = what > (int)strlen(p->what[k]) ? what : (int)strlen(p->what[k]);
     for (int k = 0; k < p->n; ++k) {
         const cal_plan *c = &p->step[k];
-        fprintf(stderr, "   %-18s %4d (%4d) %-28s %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", p->name[k], c->expected.runs,
-                c->worst.runs, p->what[k], c->expected.core_s / 3600, c->worst.core_s / 3600, c->expected.wall_s / 3600,
-                c->worst.wall_s / 3600);
+        fprintf(stderr, "   %-18s %4d (%4d) %-*s %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", p->name[k], c->expected.runs,
+                c->worst.runs, what, p->what[k], c->expected.core_s / 3600, c->worst.core_s / 3600,
+                c->expected.wall_s / 3600, c->worst.wall_s / 3600);
     }
     char e[128], w[128];
     cal_plan_describe(&p->total.expected, parallel, e, sizeof e), cal_plan_describe(&p->total.worst, parallel, w, sizeof w);

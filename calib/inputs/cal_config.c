@@ -216,20 +216,46 @@ static int check_drum_knobs(const cal_config *c, int from, const cal_tier *t, ch
     return 0;
 }
 
-// The map tier exists, is another tier, maps by itself (no chains), and turns
-// the same speeds (the correction is per measurement: one per speed).
+// Where t's chain of map tiers ends, each tier once: 0; or the located
+// error of a chain that comes back to a tier already in it (a -> b -> a, the
+// whole chain named) or goes deeper than CAL_MAX_MAP_DEPTH. A map_tier that
+// names no tier ends the chain here: that tier's own check says so.
+static int check_map_chain(const cal_config *c, const cal_tier *t, int from, char *err, size_t len)
+{
+    const cal_tier *chain[CAL_MAX_MAP_DEPTH + 2] = {t};
+    char path[(CAL_MAX_MAP_DEPTH + 2) * 36] = "";
+    int n = 1;
+    for (const cal_tier *m = t; m->map_tier; ++n) {
+        m = cal_config_tier_named(c, m->map_tier);
+        if (!m) return 0;
+        snprintf(path + strlen(path), sizeof path - strlen(path), "%s -> ", chain[n - 1]->name);
+        for (int k = 0; k < n; ++k)
+            if (chain[k] == m)
+                return located(c, from, "map_tier", err, len, "the map tiers make a cycle (%s%s): each must map with a "
+                               "cheaper tier that ends in a one-tier search", path, m->name);
+        if (n > CAL_MAX_MAP_DEPTH)
+            return located(c, from, "map_tier", err, len, "more than %d levels of map tiers (%s%s): at most %d tiers may "
+                           "map below one", CAL_MAX_MAP_DEPTH, path, m->name, CAL_MAX_MAP_DEPTH);
+        chain[n] = m;
+    }
+    return 0;
+}
+
+// The map tier exists, is another tier, turns the same speeds (the
+// correction is per measurement: one per speed), and its own chain of map
+// tiers ends (check_map_chain): a map tier may itself map with another
+// (levels, cal_stage_two_tier).
 static int check_map_tier(const cal_config *c, const cal_tier *t, int from, char *err, size_t len)
 {
     const cal_tier *m = cal_config_tier_named(c, t->map_tier);
     if (!m) return located(c, from, "map_tier", err, len, "'%s' is not one of the tiers", t->map_tier);
     if (m == t) return located(c, from, "map_tier", err, len, "'%s' is this tier itself", t->map_tier);
-    if (m->map_tier) return located(c, from, "map_tier", err, len, "'%s' has a map_tier of its own: one level only", t->map_tier);
     int same = m->rpm_count == t->rpm_count;
     for (unsigned k = 0; same && k < t->rpm_count; ++k) same = m->rpm[k] == t->rpm[k];
     if (!same) return located(c, from, "map_tier", err, len, "'%s' must turn the same rpm list as this tier", t->map_tier);
     if (t->max_evaluations < 1)
         return located(c, from, "max_evaluations", err, len, "with a map_tier it bounds this tier's runs: give >= 1");
-    return 0;
+    return check_map_chain(c, t, from, err, len);
 }
 
 // One averaging time per speed, each fitting the run like average_time, and
@@ -326,6 +352,17 @@ const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigne
 {
     *n = t->stiffness_count ? t->stiffness_count : c->stiffness_count;
     return t->stiffness_count ? t->stiffness : c->stiffness;
+}
+const cal_tier *cal_tier_map_level(const cal_config *c, const cal_tier *t, int level)
+{
+    for (int k = 0; t && k < level; ++k) t = t->map_tier ? cal_config_tier_named(c, t->map_tier) : NULL;
+    return t;
+}
+int cal_tier_map_depth(const cal_config *c, const cal_tier *t)
+{
+    int depth = 0;
+    while (depth < CAL_MAX_MAP_DEPTH && cal_tier_map_level(c, t, depth + 1)) ++depth;
+    return depth;
 }
 cal_mf_correction_kind cal_tier_map_correction(const cal_tier *t)
 {

@@ -23,6 +23,11 @@ typedef struct cal_bounds {
     double mu_s_min, mu_s_max, mu_r_min, mu_r_max;
 } cal_bounds;
 
+/// Tiers that may map below one tier (its map_tier, that tier's map_tier...):
+/// each level is a whole search run before the one above it, so a chain
+/// deeper than this is a mistake rather than a plan (checked on loading).
+enum { CAL_MAX_MAP_DEPTH = 3 };
+
 /// A fidelity tier: every accuracy knob of the virtual experiments, and
 /// the search budget that goes with it. A rung of the fidelity study is the
 /// same struct, read by the same schema, with the drum's knobs alone (name
@@ -89,7 +94,9 @@ typedef struct cal_tier {
     /// A cheaper tier that maps the friction plane first (cal_multifidelity.h):
     /// this tier then runs only where the map, corrected by the discrepancy it
     /// measures between the two, puts the optimum; max_evaluations bounds
-    /// those runs and grid is unused. NULL: a one-tier search.
+    /// those runs and grid is unused. The map tier may have a map_tier of its
+    /// own (levels: its result, runs and predictions, is this tier's map;
+    /// at most CAL_MAX_MAP_DEPTH below, no cycle). NULL: a one-tier search.
     char *map_tier;
     /// How the discrepancy measured at this tier's runs corrects the map
     /// (cal_mf_correction_kind; absent: kriging).
@@ -180,6 +187,11 @@ void cal_config_free(cal_config *c);
 const cal_tier *cal_config_tier(const cal_config *c);
 /// The tier named `name`, NULL if none.
 const cal_tier *cal_config_tier_named(const cal_config *c, const char *name);
+/// The tier `level` steps down t's chain of map tiers (0: t itself, 1: its
+/// map_tier, 2: that tier's map_tier...), NULL where the chain is shorter.
+const cal_tier *cal_tier_map_level(const cal_config *c, const cal_tier *t, int level);
+/// How many tiers map below t (0: a one-tier search), at most CAL_MAX_MAP_DEPTH.
+int cal_tier_map_depth(const cal_config *c, const cal_tier *t);
 /// Stage 1's candidates at tier t: the tier's `stiffness`, else the config's.
 const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n);
 

@@ -14,7 +14,18 @@
 // The regressors 1, u, v, u², uv, v² at (u, v).
 static void terms(double u, double v, double *x) { x[0] = 1, x[1] = u, x[2] = v, x[3] = u * u, x[4] = u * v, x[5] = v * v; }
 
-int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
+// Row i of the design at (u, v), each entry over s (1: unweighted; x / 1 is
+// x exactly, so an unweighted fit is the plain least squares bit for bit).
+static void design_row(gsl_matrix *X, int i, int p, double u, double v, double s)
+{
+    double x[CAL_MF_TERMS];
+    terms(u, v, x);
+    for (int j = 0; j < p; ++j) gsl_matrix_set(X, (size_t)i, (size_t)j, x[j] / s);
+}
+
+int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map) { return cal_mf_fit_weighted(pts, NULL, n, n_y, map); }
+
+int cal_mf_fit_weighted(const cal_mf_point *pts, const double (*sd)[CAL_MF_MAX_Y], int n, int n_y, cal_mf_map *map)
 {
     memset(map, 0, sizeof *map);
     int p = n >= 8 ? 6 : n >= 3 ? 3 : 0;
@@ -23,13 +34,14 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
     gsl_vector *y = gsl_vector_alloc((size_t)n), *c = gsl_vector_alloc((size_t)p);
     gsl_multifit_linear_workspace *work = gsl_multifit_linear_alloc((size_t)n, (size_t)p);
     int bad = !X || !cov || !y || !c || !work;
-    for (int i = 0; i < n && !bad; ++i) {
-        double x[CAL_MF_TERMS];
-        terms(pts[i].u, pts[i].v, x);
-        for (int j = 0; j < p; ++j) gsl_matrix_set(X, (size_t)i, (size_t)j, x[j]);
-    }
+    for (int i = 0; i < n && !bad && !sd; ++i) design_row(X, i, p, pts[i].u, pts[i].v, 1);
     for (int k = 0; k < n_y && !bad; ++k) {
-        for (int i = 0; i < n; ++i) gsl_vector_set(y, (size_t)i, pts[i].y[k]);
+        double weights = 0; // Σ 1/sd²: the weighted rms is sqrt(χ² / Σ 1/sd²)
+        for (int i = 0; i < n; ++i) {
+            double s = sd ? sd[i][k] : 1;
+            if (sd) design_row(X, i, p, pts[i].u, pts[i].v, s);
+            gsl_vector_set(y, (size_t)i, pts[i].y[k] / s), weights += 1 / (s * s);
+        }
         double chisq;
         size_t rank;
         // Truncated SVD: directions the points do not span (a nearly
@@ -37,7 +49,7 @@ int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map)
         // design of rank below 3 (points on a line) is refused.
         bad = gsl_multifit_linear_tsvd(X, y, 1e-10, c, cov, &chisq, &rank, work) != 0 || rank < 3;
         for (int j = 0; j < p && !bad; ++j) map->coef[k][j] = gsl_vector_get(c, (size_t)j);
-        map->rms[k] = sqrt(chisq / n);
+        map->rms[k] = sd ? sqrt(chisq / weights) : sqrt(chisq / n);
     }
     gsl_matrix_free(X), gsl_matrix_free(cov), gsl_vector_free(y), gsl_vector_free(c);
     if (work) gsl_multifit_linear_free(work);

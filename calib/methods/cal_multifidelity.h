@@ -38,6 +38,13 @@ typedef struct cal_mf_map {
 /// fitted) with fewer or a singular design.
 int cal_mf_fit(const cal_mf_point *pts, int n, int n_y, cal_mf_map *map);
 
+/// The same fit weighted: point i's measurement k counts by 1/sd[i][k]² (each
+/// sd > 0), and rms is the weighted rms residual, sqrt(Σ e²/sd² / Σ 1/sd²).
+/// For points of unequal trust: a level of a multilevel search fits its map on
+/// the level below's runs and on its predictions, which are no measurements
+/// (cal_stage_two_tier). sd NULL: cal_mf_fit.
+int cal_mf_fit_weighted(const cal_mf_point *pts, const double (*sd)[CAL_MF_MAX_Y], int n, int n_y, cal_mf_map *map);
+
 /// The map at (u, v).
 void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y);
 

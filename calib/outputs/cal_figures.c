@@ -82,6 +82,15 @@ static int map_candidates(const cal_friction_result *r)
     return n;
 }
 
+// The legend of a two-tier stage's predicted candidates: the map tier's runs
+// corrected, or where the map tier maps with another (levels) its runs and
+// its own predictions, corrected.
+static void map_legend(const cal_friction_result *r, int n, const char *note, char *out, size_t len)
+{
+    snprintf(out, len, "map tier '%s' runs%s + measured correction (%d%s)", cal_friction_map_tier(r),
+             r->n_levels > 1 ? " and predictions" : "", n, note);
+}
+
 static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_result *r, char *err, size_t len)
 {
     double *mu_s = malloc(sizeof(double) * CAL_MAX_EVALS * 3);
@@ -102,8 +111,7 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
     // correction measured here added: predicted, not evaluated at this tier.
     if (mapped) snprintf(evaluated, sizeof evaluated, "runs at this tier (%d)", r->n - mapped);
     else snprintf(evaluated, sizeof evaluated, "evaluated candidates (%d)", r->n);
-    snprintf(mapped_label, sizeof mapped_label, "map tier '%s' runs + measured correction (%d; predicted, not run here)",
-             r->map_tier, mapped);
+    map_legend(r, mapped, "; predicted, not run here", mapped_label, sizeof mapped_label);
     if (r->best >= 0)
         snprintf(chosen, sizeof chosen, "the search's choice: μs = %.3g, μr = %.3g (its status: the table)",
                  r->cand[r->best].mu_s, r->cand[r->best].mu_r);
@@ -167,8 +175,7 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
     if (d->map_points)
         snprintf(title, sizeof title, "%s: search convergence (%d runs at this tier)", stage_name(r), d->runs);
     else snprintf(title, sizeof title, "%s: search convergence (%d evaluations)", stage_name(r), d->runs);
-    snprintf(map_label, sizeof map_label, "map tier '%s' runs + measured correction (%d, at 0: not run here, never chosen)",
-             r->map_tier, d->map_points);
+    map_legend(r, d->map_points, ", at 0: not run here, never chosen", map_label, sizeof map_label);
     size_t n = (size_t)d->runs, ns = 0;
     exp_plot_series s[5];
     s[ns++] = points(n, d->index, d->matching, "run matching the angle", blue, EXP_MARK_CIRCLE);

@@ -284,8 +284,10 @@ static int write_table_h5(const char *dir, const cal_outcome *o, const cal_table
 // ---- every simulation ------------------------------------------------------------
 
 // The distinct simulations a calibration used: a run two stages share (two wall
-// materials with the same data, the same candidate) is counted once.
-enum { TALLY_DECIDING, TALLY_MAP, TALLY_CYLINDER, TALLY_KINDS };
+// materials with the same data, the same candidate) is counted once. Drum
+// runs are counted by level: TALLY_LEVEL the tier's own, TALLY_LEVEL + 1 its
+// map tier's, + 2 that tier's map tier's...
+enum { TALLY_CYLINDER, TALLY_LEVEL, TALLY_KINDS = TALLY_LEVEL + 1 + CAL_MAX_MAP_DEPTH };
 typedef struct sim_tally {
     char (*hash)[17];
     int n, cap;
@@ -307,12 +309,13 @@ static void tally_add(sim_tally *t, const char *hash, int kind, const cal_record
     t->count[kind]++, t->core_s[kind] += cal_record_cost_s(rec);
 }
 
-// Candidate i's records on bed b of tier t, one row a speed.
-static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, const cal_friction_result *r, int i, int b,
-                            const char *store, sim_tally *tally)
+// Candidate i's records on bed b of tier t, the tier at `level` of the
+// stage's levels, one row a speed.
+static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, int level, const cal_friction_result *r,
+                            int i, int b, const char *store, sim_tally *tally)
 {
-    char stage[48];
-    snprintf(stage, sizeof stage, "%s%s", r->material[0] ? r->material : "granule", t != o->tier ? " (map)" : "");
+    char stage[64];
+    cal_progress_level_name(r->material[0] ? r->material : "granule", level, stage, sizeof stage);
     const cal_candidate *k = &r->cand[i];
     cal_drum_case dc = cal_friction_case(o->config, t, r, k->mu_s, k->mu_r, b);
     double rpm[CAL_MAX_RPM + 1];
@@ -331,21 +334,21 @@ static void bed_simulations(FILE *f, const cal_outcome *o, const cal_tier *t, co
                 i + 1, hash, k->mu_s, k->mu_r, rpm[j], rec.status, rec.reason ? rec.reason : "", rec.angle_deg,
                 rec.angle_sd_deg, rec.csa_percent, rec.csa_sd_percent, rec.steady, rec.simulated_time_s, rec.wall_time_s,
                 rec.fill_wall_time_s, rec.particle_steps, rec.granules, rec.dt_s, rec.peak_rss_mb);
-        tally_add(tally, hash, t != o->tier ? TALLY_MAP : TALLY_DECIDING, &rec);
+        tally_add(tally, hash, TALLY_LEVEL + level, &rec);
         cal_record_free(&rec);
     }
 }
 
-// A stage's simulations: its own candidates', and in a two-tier stage the map
-// tier's, found through the predicted candidates that stand for them (a map
-// candidate with a failed speed has none, and is not listed).
+// A stage's simulations: its own candidates', and in a two-tier stage each
+// level's below, found through the predicted candidates that stand for them
+// (a map candidate with a failed speed has none, and is not listed).
 static void simulations_of(FILE *f, const cal_outcome *o, const cal_friction_result *r, const char *store,
                            sim_tally *tally)
 {
-    const cal_tier *map = o->tier->map_tier ? cal_config_tier_named(o->config, o->tier->map_tier) : NULL;
     for (int i = 0; i < r->n; ++i) {
-        const cal_tier *t = r->cand[i].predicted ? map : o->tier;
-        for (int b = 0; t && b < cal_tier_beds(t); ++b) bed_simulations(f, o, t, r, i, b, store, tally);
+        int level = r->cand[i].predicted ? r->cand[i].level : 0;
+        const cal_tier *t = cal_tier_map_level(o->config, o->tier, level);
+        for (int b = 0; t && b < cal_tier_beds(t); ++b) bed_simulations(f, o, t, level, r, i, b, store, tally);
     }
 }
 
@@ -425,25 +428,59 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     report_range(f, "μr", r->mu_r_range, b->mu_r_min, b->mu_r_max);
 }
 
-// A two-tier stage: what the map tier cost, what this tier's runs measured
-// against it, and how the loop ended.
-static void report_two_tier(FILE *f, const cal_friction_result *r)
+// One level's row: its tier, what it ran and cost, what its own search chose, how it ended.
+static void level_row(FILE *f, int level, const cal_level *l)
 {
+    fprintf(f, "| %d | %s | %g | %d | %d | %.3f | %.0f | %.4g, %.4g, %.2f° | %s |\n", level, l->tier, l->lambda, l->runs,
+            l->simulations, l->core_s / 3600, l->wall_time_s, l->best_mu_s, l->best_mu_r, l->best_angle_deg,
+            l->outcome ? l->outcome : "its whole one-tier search");
+}
+
+// A multilevel stage (the map tier maps with another): each level, the
+// cheapest first, with what it ran, cost and chose, so that a reader sees
+// what each level bought.
+static void report_levels(FILE *f, const cal_friction_result *r, const cal_tier *t)
+{
+    fputs("Levels, the cheapest first: each level's result (its runs and, above the first, its predicted candidates) "
+          "is the map of the level above, fitted by least squares with each point weighed by its own spread (a "
+          "prediction by the run it stands for and the kriging's spread where it stands), and corrected only by the "
+          "discrepancy measured at that level's own runs.\n\n| level | tier | λ | runs | simulations | core-hours | "
+          "wall (s) | its choice: μs, μr, angle | outcome |\n|---|---|---|---|---|---|---|---|---|\n", f);
+    for (int k = r->n_levels - 1; k >= 0; --k) level_row(f, r->n_levels - k, &r->level[k]);
+    cal_level own = {.lambda = t->lambda, .runs = r->expensive_candidates, .simulations = r->simulations,
+                     .core_s = r->core_s, .wall_time_s = r->wall_time_s, .outcome = r->two_tier_outcome,
+                     .best_mu_s = NAN, .best_mu_r = NAN, .best_angle_deg = NAN};
+    snprintf(own.tier, sizeof own.tier, "%s", t->name);
+    if (r->best >= 0)
+        own.best_mu_s = r->cand[r->best].mu_s, own.best_mu_r = r->cand[r->best].mu_r,
+        own.best_angle_deg = r->cand[r->best].angle_deg;
+    level_row(f, r->n_levels + 1, &own);
+    fputc('\n', f);
+}
+
+// A two-tier stage: what the map tier cost, what this tier's runs measured
+// against it, and how the loop ended; with levels, each level first.
+static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tier *t)
+{
+    if (r->n_levels > 1) report_levels(f, r, t);
     int predicted = 0;
     for (int i = 0; i < r->n; ++i) predicted += r->cand[i].predicted;
-    fprintf(f, "Two tiers: tier '%s' mapped the plane (%d candidates, %.0f s); this tier ran %d candidate(s) where the "
+    int levels = r->n_levels > 1; // the map tier's result is its runs and its own predictions
+    fprintf(f, "Two tiers: tier '%s' mapped the plane (%d %s, %.0f s); this tier ran %d candidate(s) where the "
                "corrected map put the optimum (%.0f s). Outcome: %s. The correction measured between the "
                "tiers (this tier minus the map, carried over the plane by %s, at the last run): angle %+.2f°",
-            r->map_tier, r->map_candidates, r->map_wall_time_s, r->expensive_candidates, r->wall_time_s,
+            r->level[0].tier, r->level[0].runs, levels ? "runs of its own, on its own map" : "candidates",
+            r->level[0].wall_time_s, r->expensive_candidates, r->wall_time_s,
             r->two_tier_outcome ? r->two_tier_outcome : "not run", r->map_correction ? r->map_correction : "-",
             r->correction[0]);
     for (int j = 0; j < r->n_rpm; ++j) fprintf(f, ", CSA at %g rpm %+.2f points", r->rpm[j], r->correction[1 + j]);
-    fprintf(f, ". The %d candidates marked \"map + correction\" below are the map tier's runs plus the correction where "
-               "they stand, "
-               "not runs of this tier: they enter the identified ranges, never the choice.\n\n", predicted);
+    fprintf(f, ". The %d candidates marked \"map + correction\" below are the map tier's runs%s plus the correction "
+               "where they stand, "
+               "not runs of this tier: they enter the identified ranges, never the choice.\n\n",
+            predicted, levels ? " and its predicted candidates" : "");
 }
 
-static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds)
+static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds, const cal_tier *t)
 {
     const char *stage = r->material[0] ? r->material : "granule-granule";
     fprintf(f, "\n## %s (surface '%s' in the data)\n\n", stage, r->surface);
@@ -451,7 +488,7 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
     fprintf(f, "Target angle %.2f° at %g rpm", r->angle_target, r->angle_rpm);
     fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. ", r->angle_tolerance,
             r->n_rpm);
-    if (r->map_tier[0]) report_two_tier(f, r);
+    if (r->n_levels) report_two_tier(f, r, t);
     else fprintf(f, "NLopt COBYLA: %s. %d candidates, %.0f s.\n\n", r->nlopt_result, r->n, r->wall_time_s);
     if (r->angle_in_misfit)
         fputs("Rule (`angle_rule: misfit`): the angle is one more measurement in the misfit, its z-score taken against "
@@ -529,17 +566,23 @@ static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
         const cal_friction_result *r = stage_of(o, i);
         if (!r) continue;
         const char *name = r->material[0] ? r->material : "granule-granule";
-        if (r->map_tier[0]) cost_row(f, name, r->map_tier, r->map_candidates, r->map_simulations, r->map_core_s);
+        for (int k = r->n_levels - 1; k >= 0; --k) // the cheapest level first, as they ran
+            cost_row(f, name, r->level[k].tier, r->level[k].runs, r->level[k].simulations, r->level[k].core_s);
         int own = 0;
         for (int k = 0; k < r->n; ++k) own += !r->cand[k].predicted;
         cost_row(f, name, o->tier->name, own, r->simulations, r->core_s);
     }
-    fprintf(f, "\nDistinct simulations in all: %d, %.2f core-hours: %d drum runs at tier '%s' (%.2f)",
-            t->n, (t->core_s[TALLY_DECIDING] + t->core_s[TALLY_MAP] + t->core_s[TALLY_CYLINDER]) / 3600,
-            t->count[TALLY_DECIDING], o->tier->name, t->core_s[TALLY_DECIDING] / 3600);
-    if (o->tier->map_tier)
-        fprintf(f, ", %d at its map tier '%s' (%.2f)", t->count[TALLY_MAP], o->tier->map_tier,
-                t->core_s[TALLY_MAP] / 3600);
+    double drum_s = 0;
+    for (int k = 0; k <= CAL_MAX_MAP_DEPTH; ++k) drum_s += t->core_s[TALLY_LEVEL + k];
+    fprintf(f, "\nDistinct simulations in all: %d, %.2f core-hours: %d drum runs at tier '%s' (%.2f)", t->n,
+            (drum_s + t->core_s[TALLY_CYLINDER]) / 3600, t->count[TALLY_LEVEL], o->tier->name,
+            t->core_s[TALLY_LEVEL] / 3600);
+    for (int k = 1; k <= cal_tier_map_depth(o->config, o->tier); ++k) {
+        const cal_tier *below = cal_tier_map_level(o->config, o->tier, k), *above = cal_tier_map_level(o->config, o->tier, k - 1);
+        if (k == 1) fprintf(f, ", %d at its map tier '%s'", t->count[TALLY_LEVEL + k], below->name);
+        else fprintf(f, ", %d at tier '%s', map tier of '%s'", t->count[TALLY_LEVEL + k], below->name, above->name);
+        fprintf(f, " (%.2f)", t->core_s[TALLY_LEVEL + k] / 3600);
+    }
     fprintf(f, ", %d poured cylinders (%.2f). A run two stages share (the same candidate for two wall materials) is "
                "counted once here and under each stage above", t->count[TALLY_CYLINDER], t->core_s[TALLY_CYLINDER] / 3600);
     fputs(". For scale: the paper ran 14 poured cylinders for the stiffness (section 4.1) and, per drum lining, "
@@ -595,7 +638,7 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
     }
     for (int i = 0; i < n_stages(o); ++i)
         if (stage_of(o, i)) {
-            report_friction(f, stage_of(o, i), stage_bounds(o, i));
+            report_friction(f, stage_of(o, i), stage_bounds(o, i), o->tier);
             report_posterior(f, stage_of(o, i), stage_bounds(o, i), post->ok[i] ? &post->of[i] : NULL, post->why[i]);
         }
     report_cost(f, o, tally);

@@ -18,7 +18,7 @@
 #include "exp_drum_turn.h"
 
 // How this environment's drum runs are counted in the progress.
-static cal_run_kind drum_kind(const cal_env *env) { return env->mapping ? CAL_RUN_MAP_DRUM : CAL_RUN_DRUM; }
+static cal_run_kind drum_kind(const cal_env *env) { return cal_progress_drum_kind(env->mapping); }
 
 // The config's damping reading (its name was checked when the config was loaded).
 static dem_damping_mode config_damping(const cal_config *c)
@@ -435,7 +435,7 @@ static void settled_and_turned(int i, int code, void *ctx)
 
 void cal_env_set_stage(cal_env *env, const char *stage)
 {
-    snprintf(env->stage, sizeof env->stage, env->mapping ? "%.50s (map)" : "%s", stage);
+    cal_progress_level_name(stage, env->mapping, env->stage, sizeof env->stage);
 }
 
 

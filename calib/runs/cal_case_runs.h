@@ -28,8 +28,10 @@ typedef struct cal_env {
     double checkpoint_every_s;
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
     cal_progress *progress;             ///< the whole calibration's, or NULL (a study, a single run)
-    int mapping;                        ///< 1 while a two-tier stage's map tier runs: its drum runs
-                                        ///< are counted as CAL_RUN_MAP_DRUM, its stage "NAME (map)"
+    int mapping;                        ///< the level running in a two-tier stage: 0 the tier's own, 1
+                                        ///< its map tier, 2 that tier's map tier...: its drum runs are
+                                        ///< counted by level (cal_progress_drum_kind), its stage named
+                                        ///< "NAME (map)", "NAME (map 2)"... (cal_progress_level_name)
     /// The last settled bed and the text that defined it: the wall stage's
     /// candidates all turn the same one (cal_drum_case_wall), so it is
     /// settled once per process. Freed by cal_sim_release.

@@ -6,7 +6,21 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *const kind_name[CAL_RUN_KINDS] = {"cylinder", "drum", "map-tier drum"};
+static const char *const kind_name[CAL_RUN_KINDS] = {"cylinder", "drum", "map-tier drum", "level-2 map drum",
+                                                      "level-3 map drum"};
+
+cal_run_kind cal_progress_drum_kind(int level)
+{
+    if (level <= 0) return CAL_RUN_DRUM;
+    return (cal_run_kind)(CAL_RUN_MAP_DRUM + (level <= CAL_MAX_MAP_DEPTH ? level : CAL_MAX_MAP_DEPTH) - 1);
+}
+
+void cal_progress_level_name(const char *stage, int level, char *out, size_t len)
+{
+    if (level <= 0) snprintf(out, len, "%s", stage);
+    else if (level == 1) snprintf(out, len, "%.50s (map)", stage);
+    else snprintf(out, len, "%.50s (map %d)", stage, level);
+}
 
 void cal_progress_init(cal_progress *p, int parallel)
 {

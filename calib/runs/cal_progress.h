@@ -14,14 +14,31 @@
 
 #include <stddef.h>
 
-/// Kinds of simulation, each with its own cost: a two-tier stage's map-tier
-/// drum runs cost a small part of the tier's own.
-typedef enum cal_run_kind { CAL_RUN_CYLINDER = 0, CAL_RUN_DRUM = 1, CAL_RUN_MAP_DRUM = 2, CAL_RUN_KINDS = 3 } cal_run_kind;
+#include "cal_config.h"
 
-enum { CAL_PROGRESS_MAX_STAGES = 20 };
+/// Kinds of simulation, each with its own cost: a two-tier stage's map-tier
+/// drum runs cost a small part of the tier's own, and each level further down
+/// (a map tier's own map tier) a part of the level above's.
+typedef enum cal_run_kind {
+    CAL_RUN_CYLINDER = 0,
+    CAL_RUN_DRUM = 1,
+    CAL_RUN_MAP_DRUM = 2, ///< level 1 (the map tier); level d is CAL_RUN_MAP_DRUM + d - 1
+    CAL_RUN_KINDS = CAL_RUN_MAP_DRUM + CAL_MAX_MAP_DEPTH
+} cal_run_kind;
+
+/// The drum runs' kind at a level of a multilevel stage (0: the tier's own).
+cal_run_kind cal_progress_drum_kind(int level);
+
+/// A stage's name at a level: "granule" at 0, "granule (map)" at its map
+/// tier, "granule (map 2)" a level further down, and so on.
+void cal_progress_level_name(const char *stage, int level, char *out, size_t len);
+
+/// Stage 1, then each friction stage (the granule's and 16 materials') at
+/// each level.
+enum { CAL_PROGRESS_MAX_STAGES = 1 + 17 * (CAL_MAX_MAP_DEPTH + 1) };
 
 typedef struct cal_progress_stage {
-    char name[64]; ///< a material's name (< 32), with " (map)" for a map tier's step
+    char name[64]; ///< a material's name (< 32), with its level (cal_progress_level_name)
     cal_run_kind kind;
     int planned; ///< at most this many simulations
     int done;    ///< run now or found in the store

@@ -72,8 +72,11 @@ static int build_model(const cal_friction_result *r, const cal_bounds *b, model 
     m->r = r;
     if (r->has_map) {
         m->map = r->cheap_map, m->correction = &r->discrepancy;
-        out->model = "the corrected map of the two-tier search (the map tier's quadratic map plus the discrepancy "
-                     "measured at this tier's runs)";
+        out->model = r->n_levels > 1 ? "the corrected map of the multilevel search (the quadratic map through the "
+                                       "map tier's runs and predictions, each weighed by its spread, plus the "
+                                       "discrepancy measured at this tier's runs)"
+                                     : "the corrected map of the two-tier search (the map tier's quadratic map plus "
+                                       "the discrepancy measured at this tier's runs)";
     } else {
         if (fit_own_map(r, b, &m->map)) return 1;
         out->model = m->map.n_terms == CAL_MF_TERMS ? "a quadratic map through this tier's own candidates"

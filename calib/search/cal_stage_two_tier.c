@@ -11,6 +11,12 @@
 // corrected by the measured discrepancy (their measurements at the map tier
 // plus the correction where they stand, marked "predicted"), since a handful
 // of expensive runs alone would say nothing about the range.
+//
+// Levels: a map tier that has a map_tier of its own is itself such a stage,
+// run first (ci -> λ 1000 -> λ 512: the λ 1000 stage maps with ci, and its
+// result maps for λ 512). The level above fits its map on that result and
+// corrects it by the discrepancy measured at its own runs alone, as two tiers
+// do: no correction comes from another level or from any known answer.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,36 +69,84 @@ static int run_here(double u, double v, double *y, void *ctx)
     return 0;
 }
 
-// The map from the cheap stage's usable candidates, in this stage's unit square.
-static int fit_map(const cal_friction_result *cheap, const cal_bounds *b, int n_y, cal_mf_map *map)
+// One candidate's own noise at tier t, per measurement (angle, then CSA per
+// speed): the tier's seed spreads over its beds. The kriging smooths it at
+// this tier's runs; a level above weighs this tier's runs by it.
+static void run_noise_of(const cal_tier *t, const cal_friction_result *r, double *noise)
+{
+    noise[0] = t->angle_sd_deg / sqrt(cal_tier_beds(t));
+    for (int i = 0; i < r->n_rpm; ++i) noise[1 + i] = r->csa_tier_sd[i];
+}
+
+// A point's weight in a level's map is floored at this share of the data's
+// spread: a tier whose spread is unmeasured (0) would otherwise weigh
+// infinitely, and differences far below the data's spread do not move the
+// search.
+static const double sd_floor_of_spread = 0.1;
+
+// Each usable candidate's standard deviation in the map of the level above:
+// its tier's run noise for a run, its own predicted_sd for a prediction.
+static void point_sd(const cal_friction_result *cheap, const cal_candidate *k, const double *cheap_noise,
+                     const cal_friction_result *r, double *sd)
+{
+    double floor_sd[CAL_MF_MAX_Y];
+    floor_sd[0] = sd_floor_of_spread * cal_friction_angle_spread(r);
+    for (int i = 0; i < r->n_rpm; ++i) floor_sd[1 + i] = sd_floor_of_spread * cal_friction_csa_spread(r, i);
+    for (int j = 0; j < n_measurements(cheap); ++j) sd[j] = fmax(k->predicted ? k->predicted_sd[j] : cheap_noise[j], floor_sd[j]);
+}
+
+// The map from the cheap stage's usable candidates, in this stage's unit
+// square. A one-tier cheap stage: plain least squares through its runs, as
+// two tiers always did. A two-tier cheap stage (levels): through its runs AND
+// its predicted candidates, weighted by 1/sd². Its few runs alone (the λ 1000
+// stage makes ~4) would give a plane at best and throw away what its map
+// learned over the whole square; its predictions carry that map, corrected by
+// what its runs measured. But they are not measurements: each counts with
+// its own sd (the run it stands for and the kriging's sd of the correction
+// where it stands, large far from that level's runs), so near the lower
+// level's runs the fit follows those runs and far from them the prediction
+// counts for what it is worth. The kriging of this level's discrepancy then
+// sees this level's runs alone, with their own noise as its nugget: no
+// predicted point is ever one of its exact data.
+static int fit_map(const cal_friction_result *cheap, const double *cheap_noise, const cal_friction_result *r,
+                   const cal_bounds *b, int n_y, cal_mf_map *map)
 {
     cal_mf_point *pts = calloc((size_t)cheap->n, sizeof *pts);
-    if (!pts) return 1;
+    double(*sd)[CAL_MF_MAX_Y] = calloc((size_t)cheap->n, sizeof *sd);
+    if (!pts || !sd) return free(pts), free(sd), 1;
     int n = 0;
     for (int i = 0; i < cheap->n; ++i)
         if (!cal_candidate_vector(cheap, &cheap->cand[i], pts[n].y)) {
             cal_friction_to_unit(b, cheap->cand[i].mu_s, cheap->cand[i].mu_r, &pts[n].u, &pts[n].v);
+            point_sd(cheap, &cheap->cand[i], cheap_noise, r, sd[n]);
             n++;
         }
-    int bad = cal_mf_fit(pts, n, n_y, map);
-    free(pts);
+    int bad = cal_mf_fit_weighted(pts, cheap->n_levels ? (const double(*)[CAL_MF_MAX_Y])sd : NULL, n, n_y, map);
+    free(pts), free(sd);
     return bad;
 }
 
-// Every usable map candidate, corrected where it stands, as a predicted candidate of this stage.
-static void add_predicted(cal_friction_result *r, const cal_friction_result *cheap, const cal_bounds *b,
-                          const cal_mf_correction *correction)
+// Every usable map candidate, corrected where it stands, as a predicted
+// candidate of this stage, with its own sd (its source's noise and the
+// kriging's sd of the correction, in quadrature) for a level above.
+static void add_predicted(cal_friction_result *r, const cal_friction_result *cheap, const double *cheap_noise,
+                          const cal_bounds *b, const cal_mf_correction *correction)
 {
     for (int i = 0; i < cheap->n && r->n < CAL_MAX_EVALS; ++i) {
+        const cal_candidate *from = &cheap->cand[i];
         double y[CAL_MF_MAX_Y], u, v;
-        if (cal_candidate_vector(cheap, &cheap->cand[i], y)) continue;
-        cal_friction_to_unit(b, cheap->cand[i].mu_s, cheap->cand[i].mu_r, &u, &v);
+        if (cal_candidate_vector(cheap, from, y)) continue;
+        cal_friction_to_unit(b, from->mu_s, from->mu_r, &u, &v);
         cal_mf_correct(correction, n_measurements(r), u, v, y);
         cal_candidate *k = &r->cand[r->n++];
         memset(k, 0, sizeof *k);
-        k->mu_s = cheap->cand[i].mu_s, k->mu_r = cheap->cand[i].mu_r;
-        k->origin = "map + correction", k->predicted = 1;
+        k->mu_s = from->mu_s, k->mu_r = from->mu_r;
+        k->origin = "map + correction", k->predicted = 1, k->level = from->level + 1;
         k->angle_sd_deg = NAN;
+        for (int j = 0; j < n_measurements(r); ++j) {
+            double source = from->predicted ? from->predicted_sd[j] : cheap_noise[j];
+            k->predicted_sd[j] = hypot(source, cal_mf_correction_sd(correction, j, u, v));
+        }
         candidate_of(r, y, k);
     }
 }
@@ -105,11 +159,33 @@ static const char *outcome_of(const cal_mf_result *m)
     return "stopped at max_evaluations without agreeing with the corrected map";
 }
 
+// What a level below this stage ran, cost and chose.
+static void describe_level(cal_level *l, const cal_friction_result *r, const cal_tier *t)
+{
+    memset(l, 0, sizeof *l);
+    snprintf(l->tier, sizeof l->tier, "%s", t->name);
+    l->lambda = t->lambda;
+    for (int i = 0; i < r->n; ++i) l->runs += !r->cand[i].predicted;
+    l->simulations = r->simulations, l->core_s = r->core_s, l->wall_time_s = r->wall_time_s;
+    l->outcome = r->n_levels ? r->two_tier_outcome : NULL;
+    const cal_candidate *best = r->best >= 0 ? &r->cand[r->best] : NULL;
+    l->best_mu_s = best ? best->mu_s : NAN, l->best_mu_r = best ? best->mu_r : NAN;
+    l->best_angle_deg = best ? best->angle_deg : NAN;
+}
+
+// The levels below this stage: its map tier, then the map tier's own levels.
+static void keep_levels(cal_friction_result *out, const cal_friction_result *cheap, const cal_tier *map_tier)
+{
+    describe_level(&out->level[0], cheap, map_tier);
+    out->n_levels = 1;
+    for (int k = 0; k < cheap->n_levels && out->n_levels < CAL_MAX_MAP_DEPTH; ++k) out->level[out->n_levels++] = cheap->level[k];
+}
+
 // What the loop did, into the stage's result (and on stderr): its runs
 // against their predictions, the outcome, the correction, and the map's
 // candidates corrected as predicted candidates.
-static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const cal_mf_map *map,
-                      const cal_mf_result *m, const char *tier, const cal_bounds *b)
+static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const double *cheap_noise,
+                      const cal_mf_map *map, const cal_mf_result *m, const char *tier, const cal_bounds *b)
 {
     out->has_map = !m->failed && m->n > 0, out->cheap_map = *map, out->discrepancy = m->correction;
     out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
@@ -120,7 +196,29 @@ static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap
                 tier, m->run[i].y[0], m->predicted[i][0]);
     fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction at the last run: angle %+.2f°\n", out->two_tier_outcome,
             m->n, tier, m->delta[0]);
-    if (!m->failed && m->n > 0) add_predicted(out, cheap, b, &m->correction);
+    if (!m->failed && m->n > 0) add_predicted(out, cheap, cheap_noise, b, &m->correction);
+}
+
+// The level below, whole: the map tier's one-tier search, or where the map
+// tier maps with another, its own two-tier stage (recursing; the config
+// check bounds the depth and refuses cycles). env->mapping is the level
+// running, for progress labels and costs.
+static int map_stage(cal_env *env, const cal_config *c, const cal_tier *map_tier, const cal_series *angles,
+                     const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s, double gg_mu_r,
+                     cal_friction_result *cheap, char *err, size_t len)
+{
+    fprintf(stderr, "-- map: the whole search at tier '%s' (lambda %g)\n", map_tier->name, map_tier->lambda);
+    int level = env->mapping, bad;
+    env->mapping = level + 1; // progress: "NAME (map)", "NAME (map 2)"..., counted by level
+    if (map_tier->map_tier) {
+        cal_friction_result *cheaper = calloc(1, sizeof *cheaper);
+        bad = !cheaper ? exp_fail(err, len, "out of memory")
+                       : cal_stage_two_tier(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap,
+                                            cheaper, err, len);
+        free(cheaper);
+    } else bad = cal_stage_friction(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len);
+    env->mapping = level;
+    return bad;
 }
 
 int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
@@ -128,11 +226,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
                        double gg_mu_r, cal_friction_result *out, cal_friction_result *cheap, char *err, size_t len)
 {
     const cal_tier *map_tier = cal_config_tier_named(c, t->map_tier); // checked on loading
-    fprintf(stderr, "-- map: the whole search at tier '%s' (lambda %g)\n", map_tier->name, map_tier->lambda);
-    env->mapping = 1; // progress: "NAME (map)", counted as map-tier drum runs
-    int bad = cal_stage_friction(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len);
-    env->mapping = 0;
-    if (bad) return 1;
+    if (map_stage(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len)) return 1;
     cal_env_set_stage(env, material ? material->name : "granule");
     cal_progress_enter(env->progress, env->stage);
     two_tier tt = {.r = out};
@@ -140,21 +234,20 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     if (!tt.search) return 1;
     tt.bounds = cal_friction_bounds(tt.search);
     int n_y = n_measurements(out);
-    snprintf(out->map_tier, sizeof out->map_tier, "%s", map_tier->name);
-    out->map_candidates = cheap->n, out->map_wall_time_s = cheap->wall_time_s;
-    out->map_simulations = cheap->simulations, out->map_core_s = cheap->core_s;
+    keep_levels(out, cheap, map_tier);
     out->nlopt_result = "NLopt BOBYQA on the corrected map (two tiers)";
+    // Agreement within the data's noise (the lab's and the tier's); kriging
+    // smooths only the tier's own (a candidate's seed spread).
+    double noise[CAL_MF_MAX_Y], run_noise[CAL_MF_MAX_Y], cheap_noise[CAL_MF_MAX_Y];
+    noise[0] = out->angle_tolerance;
+    for (int i = 0; i < out->n_rpm; ++i) noise[1 + i] = cal_friction_csa_spread(out, i);
+    run_noise_of(t, out, run_noise), run_noise_of(map_tier, cheap, cheap_noise);
     cal_mf_map map;
-    if (n_y > CAL_MF_MAX_Y || fit_map(cheap, tt.bounds, n_y, &map)) {
+    if (n_y > CAL_MF_MAX_Y || fit_map(cheap, cheap_noise, out, tt.bounds, n_y, &map)) {
         out->two_tier_outcome = "not run: too few usable map candidates to fit the map";
         return cal_friction_finish(tt.search) || exp_fail(err, len, "%s: %s (tier '%s')", env->stage, out->two_tier_outcome,
                                                           map_tier->name);
     }
-    // Agreement within the data's noise (the lab's and the tier's); kriging
-    // smooths only the tier's own (a candidate's seed spread).
-    double noise[CAL_MF_MAX_Y], run_noise[CAL_MF_MAX_Y];
-    noise[0] = out->angle_tolerance, run_noise[0] = t->angle_sd_deg / sqrt(cal_tier_beds(t));
-    for (int i = 0; i < out->n_rpm; ++i) noise[1 + i] = cal_friction_csa_spread(out, i), run_noise[1 + i] = out->csa_tier_sd[i];
     cal_mf_problem p = {.n_y = n_y, .objective = map_objective, .run_expensive = run_here, .noise = noise, .run_noise = run_noise,
                         .max_expensive = t->max_evaluations, .ctx = &tt, .correction = cal_tier_map_correction(t)};
     out->map_correction = cal_mf_correction_name(p.correction);
@@ -163,7 +256,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     cal_mf_result *m = calloc(1, sizeof *m);
     if (!m) return cal_friction_finish(tt.search), exp_fail(err, len, "out of memory");
     cal_mf_search(&map, &p, m);
-    keep_loop(out, cheap, &map, m, t->name, tt.bounds);
+    keep_loop(out, cheap, cheap_noise, &map, m, t->name, tt.bounds);
     free(m);
     return cal_friction_finish(tt.search);
 }

@@ -52,6 +52,13 @@ typedef struct cal_candidate {
     int predicted;                      ///< 1: not run at this tier but the corrected cheap map's value
                                         ///< at a cheap candidate (two-tier stage): in the identified
                                         ///< range, never the chosen pair
+    int level;                          ///< the level of the run it stands for: 0 this tier's, 1 its
+                                        ///< map tier's, 2 that tier's map tier's...
+    /// A predicted candidate's own standard deviation per measurement (angle,
+    /// then CSA per speed): the noise of the run it stands for and the
+    /// correction's kriging sd where it stands, in quadrature (0 for a run).
+    /// The level above weighs it by this when it fits its map on this stage.
+    double predicted_sd[CAL_MAX_RPM + 1];
     double chi2;                        ///< χ² against the data with the lab's and the tier's spreads (identification)
     int identified;                     ///< 1 if the data cannot tell it from the best χ² (Δχ² within the threshold)
     double wall_time_s;
@@ -75,6 +82,19 @@ typedef struct cal_range {
 
 /// Set g's bracket from below/above and the search bounds.
 void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi);
+
+/// One tier below a two-tier stage's own (its map tier, or a level further
+/// down where the map tier maps with another): what it ran, what it cost and
+/// what its own search chose, so that a report shows what each level bought.
+typedef struct cal_level {
+    char tier[32];
+    double lambda;
+    int runs;           ///< candidates run at that tier (its predicted ones not counted)
+    int simulations;    ///< their drum runs (stored ones included) and single-core seconds
+    double core_s, wall_time_s;
+    const char *outcome; ///< a two-tier level's loop end (cal_friction_result.two_tier_outcome); NULL: a one-tier search
+    double best_mu_s, best_mu_r, best_angle_deg; ///< that level's chosen pair and its angle (NAN: none)
+} cal_level;
 
 /// What a friction stage found.
 typedef struct cal_friction_result {
@@ -100,14 +120,12 @@ typedef struct cal_friction_result {
     double wall_time_s;
     int simulations;                    ///< drum runs of this tier's candidates (stored ones included)
     double core_s;                      ///< what they cost, single-core seconds (their records' costs)
-    /// Two-tier stage (tier with map_tier): the cheap tier, its runs and
-    /// cost, the correction measured (angle, then CSA per speed), and how the
-    /// loop ended. map_tier[0] == 0: a one-tier stage.
-    char map_tier[32];
-    int map_candidates, expensive_candidates;
-    double map_wall_time_s;
-    int map_simulations;                ///< the map tier's drum runs, and their single-core seconds
-    double map_core_s;
+    /// Two-tier stage (tier with map_tier): the tiers below it, their runs
+    /// and cost, the correction measured (angle, then CSA per speed), and
+    /// how the loop ended. n_levels 0: a one-tier stage.
+    int n_levels;
+    cal_level level[CAL_MAX_MAP_DEPTH]; ///< nearest first: level[0] is the map tier
+    int expensive_candidates;
     double correction[CAL_MAX_RPM + 1]; ///< at the last run (cal_mf_result.delta)
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
@@ -144,6 +162,12 @@ void cal_friction_identify(cal_friction_result *r);
 /// itself then says why).
 int cal_friction_planned_runs(const cal_config *c, const cal_tier *t, const cal_series *angles,
                               const cal_series *areas, const cal_material *material);
+
+/// The map tier's name of a stage (level[0]'s), "" for a one-tier stage.
+static inline const char *cal_friction_map_tier(const cal_friction_result *r)
+{
+    return r->n_levels ? r->level[0].tier : "";
+}
 
 /// A friction search in progress (targets set from the data, candidates so far).
 typedef struct cal_friction_search cal_friction_search;
@@ -194,7 +218,9 @@ int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, d
 /// The same stage across two tiers (the tier's map_tier maps, the tier itself
 /// decides; cal_multifidelity.h): the cheap tier's whole search first (its
 /// candidates in cheap_out), then the tier's own runs where the corrected map
-/// puts the optimum.
+/// puts the optimum. A map tier with a map_tier of its own is itself such a
+/// stage (levels, run first, deepest first): its result, its runs and its
+/// predicted candidates, is the map of the level above.
 int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, const cal_series *angles,
                        const cal_series *areas, double k_n, const cal_material *material, double gg_mu_s,
                        double gg_mu_r, cal_friction_result *out, cal_friction_result *cheap_out, char *err, size_t len);

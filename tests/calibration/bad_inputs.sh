@@ -52,10 +52,10 @@ expect "fractional --jobs" "--jobs '2.5': expected a whole number in 1..1024" --
 expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perhaps" -- "$(edit probes 's/bound_probes: false/bound_probes: perhaps/')" "${out[@]}"
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
-expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm 's/^    max_time: 1.5/    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
-expect "unknown steady rule" "steady_rule: 'eyeball': use windows or mser" -- "$(edit steady 's/^    max_time: 1.5/    max_time: 1.5\n    steady_rule: eyeball/')" "${out[@]}"
-expect "mser without its targets" "steady_rule mser needs steady_se_angle_deg and steady_se_csa_percent > 0 (got 0.2, 0)" -- "$(edit mser_se 's/^    max_time: 1.5/    max_time: 1.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2/')" "${out[@]}"
-expect "mser with an averaging time" "steady_rule: mser stops each run itself: give no average_time" -- "$(edit mser_avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 0.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2\n    steady_se_csa_percent: 0.1/')" "${out[@]}"
+expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm '0,/^    max_time: 1.5/s//    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
+expect "unknown steady rule" "steady_rule: 'eyeball': use windows or mser" -- "$(edit steady '0,/^    max_time: 1.5/s//    max_time: 1.5\n    steady_rule: eyeball/')" "${out[@]}"
+expect "mser without its targets" "steady_rule mser needs steady_se_angle_deg and steady_se_csa_percent > 0 (got 0.2, 0)" -- "$(edit mser_se '0,/^    max_time: 1.5/s//    max_time: 1.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2/')" "${out[@]}"
+expect "mser with an averaging time" "steady_rule: mser stops each run itself: give no average_time" -- "$(edit mser_avg '0,/^    max_time: 1.5/s//    max_time: 1.5\n    average_time: 0.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2\n    steady_se_csa_percent: 0.1/')" "${out[@]}"
 # A tier the user asked for names the option, the file and the tiers it has; one the file names, its line.
 tiers=$(sed -n 's/^  - name: \(.*\)/\1/p' "$work/configs/good.yaml" | paste -sd, | sed 's/,/, /g')
 expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
@@ -89,6 +89,13 @@ expect "stage 1 over the budget" "over --budget-hours 0.0001, which judges the e
 expect "a budget not a number" "--budget-hours 'soon'" -- "$work/configs/good.yaml" --budget-hours soon "${out[@]}"
 expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
 expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
+# Levels (issue 37.2): a map tier may map with another, but never round in a cycle nor onto itself;
+# each refused at the map_tier line of the first tier the check meets, with the chain it found.
+line_of() { grep -n "$2" "$1" | head -1 | cut -d: -f1; }
+self=$(edit map_self 's/map_tier: check$/map_tier: check-two-tier/')
+expect "map tier itself" "map_self.yaml:$(line_of "$self" 'map_tier: check-two-tier$'): map_tier: 'check-two-tier' is this tier itself" -- "$self" "${out[@]}"
+cycle=$(edit map_cycle 's/map_tier: check$/map_tier: check-levels/')
+expect "map tiers in a cycle" "map_cycle.yaml:$(line_of "$cycle" 'map_tier: check-levels'): map_tier: the map tiers make a cycle (check-two-tier -> check-levels -> check-two-tier)" -- "$cycle" "${out[@]}"
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"

@@ -174,6 +174,15 @@ static void test_shipped_config_loads(void **state)
     assert_true(cal_tier_average_time(standard, 4) == 8 && cal_tier_average_time(standard, 40) == 2 &&
                 cal_tier_average_time(standard, 116) == 2);
     cal_config_free(c);
+    // fine-levels: three levels, lambda 512 on the standard tier's stage, itself on ci's
+    c = cal_config_load(path, "fine-levels", err, sizeof err);
+    if (!c) fail_msg("%s", err);
+    const cal_tier *top = cal_config_tier(c);
+    assert_int_equal(cal_tier_map_depth(c, top), 2);
+    assert_string_equal(cal_tier_map_level(c, top, 1)->name, "standard");
+    assert_string_equal(cal_tier_map_level(c, top, 2)->name, "ci");
+    assert_null(cal_tier_map_level(c, top, 3));
+    cal_config_free(c);
 }
 
 // bound_probes: true, and false, read as such (not as a pointer's value).
@@ -216,6 +225,29 @@ static void expect_config_error(const char *from, const char *to, const char *fi
     if (c) fail_msg("accepted %s", to);
     snprintf(want, sizeof want, "%s:%d: %s", path, line, field);
     if (!strstr(err, want)) fail_msg("expected '%s' in: %s", want, err);
+    unlink(path);
+}
+
+// A chain of map tiers deeper than CAL_MAX_MAP_DEPTH is refused at the map_tier of the
+// tier that makes it so (two tiers added on top of the three check levels: four below it).
+static void test_map_chain_too_deep(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/granucal_cfg_XXXXXX", err[1024];
+    static char edited[1 << 16];
+    const char *drum = "    purpose: demonstration\n    lambda: 65536\n    slice_depth: 0.04\n    max_time: 1.5\n"
+                       "    window: 0.5\n    rpm: [116]\n    cylinder_lambda: 262144\n    seeds: 2\n    grid: 0\n"
+                       "    max_evaluations: 2\n";
+    char deeper[2048];
+    snprintf(deeper, sizeof deeper, "    map_tier: check-two-tier\n  - name: deep\n%s    map_tier: check-levels\n"
+             "  - name: deeper\n%s    map_tier: deep\n", drum, drum);
+    edit_shipped("calibration.yaml", "    map_tier: check-two-tier\n", deeper, edited, sizeof edited);
+    close(mkstemp(path));
+    write_file(path, edited);
+    cal_config *c = cal_config_load(path, NULL, err, sizeof err);
+    if (c) fail_msg("accepted a chain of 4 map tiers");
+    if (!strstr(err, ": map_tier: more than 3 levels of map tiers (deeper -> deep -> check-levels -> check-two-tier -> check)"))
+        fail_msg("unexpected: %s", err);
     unlink(path);
 }
 
@@ -572,6 +604,7 @@ int main(void)
         cmocka_unit_test(test_shipped_config_loads),
         cmocka_unit_test(test_bound_probes_read),
         cmocka_unit_test(test_bad_config_named_by_line_and_field),
+        cmocka_unit_test(test_map_chain_too_deep),
         cmocka_unit_test(test_average_time_per_rpm),
         cmocka_unit_test(test_fuzz_findings_refused),
         cmocka_unit_test(test_store_round_trip_and_collision_check),

@@ -115,6 +115,37 @@ static void too_few_points_are_refused(void **state)
     assert_int_equal(cal_mf_fit(pts, 2, N_Y, &map), 1);
 }
 
+// The weighted fit (a level's map on the level below's runs and predictions):
+// equal spreads give the plain fit bit for bit; a point with a large spread
+// barely moves the map, the same point trusted drags it.
+static void a_weighted_fit_trusts_each_point_by_its_spread(void **state)
+{
+    (void)state;
+    twin t = TWIN(1.5, -2.0, 0.7, 0, 0, 0);
+    cal_mf_point pts[10];
+    double sd[10][CAL_MF_MAX_Y];
+    for (int i = 0; i < 9; ++i) {
+        pts[i].u = (i / 3 + 0.5) / 3, pts[i].v = (i % 3 + 0.5) / 3;
+        cheap_response(&t, pts[i].u, pts[i].v, pts[i].y);
+    }
+    pts[9] = pts[4], pts[9].y[0] += 10; // an outlier on the centre
+    for (int i = 0; i < 10; ++i)
+        for (int k = 0; k < CAL_MF_MAX_Y; ++k) sd[i][k] = 1;
+    cal_mf_map plain, equal, doubted, trusted;
+    assert_int_equal(cal_mf_fit(pts, 10, N_Y, &plain), 0);
+    assert_int_equal(cal_mf_fit_weighted(pts, (const double(*)[CAL_MF_MAX_Y])sd, 10, N_Y, &equal), 0);
+    assert_memory_equal(&plain, &equal, sizeof plain);
+    sd[9][0] = 100;
+    assert_int_equal(cal_mf_fit_weighted(pts, (const double(*)[CAL_MF_MAX_Y])sd, 10, N_Y, &doubted), 0);
+    sd[9][0] = 0.01;
+    assert_int_equal(cal_mf_fit_weighted(pts, (const double(*)[CAL_MF_MAX_Y])sd, 10, N_Y, &trusted), 0);
+    double want[N_Y], y_doubted[N_Y], y_trusted[N_Y];
+    cheap_response(&t, pts[4].u, pts[4].v, want);
+    cal_mf_predict(&doubted, pts[4].u, pts[4].v, y_doubted), cal_mf_predict(&trusted, pts[4].u, pts[4].v, y_trusted);
+    assert_true(fabs(y_doubted[0] - want[0]) < 0.01); // 10 at a spread of 100 against nine at 1
+    assert_true(fabs(y_trusted[0] - want[0]) > 9);     // followed within its spread of 0.01
+}
+
 // A constant bias between the tiers: the first expensive run measures it
 // exactly, the corrected map is the expensive response, and the second run
 // lands on the expensive optimum and agrees with its prediction.
@@ -274,6 +305,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_quadratic_is_fitted_exactly),
         cmocka_unit_test(too_few_points_are_refused),
+        cmocka_unit_test(a_weighted_fit_trusts_each_point_by_its_spread),
         cmocka_unit_test(a_constant_bias_is_measured_and_removed),
         cmocka_unit_test(a_varying_bias_converges_within_noise),
         cmocka_unit_test(a_bias_along_mu_r_is_fitted),

@@ -205,7 +205,7 @@ static void two_tier_figures_with_the_target_not_reached(void **state)
     char err[512];
     friction_stage(r, 3);
     snprintf(r->material, sizeof r->material, "PP");
-    snprintf(r->map_tier, sizeof r->map_tier, "ci");
+    snprintf(r->level[0].tier, sizeof r->level[0].tier, "ci"), r->n_levels = 1;
     r->angle_target = 20; // below every candidate's angle
     r->csa_source = (cal_provenance){1, 512};
     for (int i = 5; i < r->n; ++i) r->cand[i].predicted = 1;
