@@ -19,7 +19,8 @@
 #include "exp_cylinder_runner.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
-#include "exp_silo.h"
+#include "exp_silo_config.h"
+#include "exp_silo_runner.h"
 
 static const char simulate_synopsis[] =
     "usage: granucal simulate SCENE.yaml [--set KEY=VALUE ...] [--rpm-list LIST] [--out DIR]\n"

@@ -2,7 +2,6 @@
 // The silo discharge benchmark (Appendix A.2, Table A.2).
 #include "exp_silo.h"
 
-#include <cyaml/cyaml.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,8 +11,6 @@
 
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
-#include "exp_result.h"
-#include "exp_yaml.h"
 
 exp_silo_def exp_default_silo_def(void)
 {
@@ -130,13 +127,15 @@ static long add_rings(dem_world *w, const exp_silo_def *d, double outer, double 
 }
 
 // Radius of the innermost ring of the plate: the orifice's clear radius is
-// this less a.
+// this less a (exp_silo_orifice_clear_radius).
 static double plate_inner_ring(const exp_silo_def *d)
 {
     double a = d->plate_sphere_radius, outer = d->silo_radius - a, rho = outer;
     while (rho - 2.02 * a - a >= d->orifice_radius - 1e-9) rho -= 2.02 * a;
     return rho;
 }
+
+double exp_silo_orifice_clear_radius(const exp_silo_def *d) { return plate_inner_ring(d) - d->plate_sphere_radius; }
 
 // Kinetic energy of the flowing granules (ids from n_fixed on).
 static void flowing_ke(const dem_world *w, size_t n_fixed, double *ket, double *ker)
@@ -332,168 +331,4 @@ int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const 
     if (!rc) rc = exp_plot_png(path, &ax2, 1, &s, 900, 500, err, len);
     free(t), free(c), free(ke);
     return rc;
-}
-
-// ------------------------------------------------------------ config + CLI
-
-typedef struct silo_yaml {
-    char *experiment;
-    double median_diameter, geometric_sd, truncation_sigmas, density;
-    double k_n, k_s, wall_k_n, wall_k_s, xi, mu_s;
-    int n_granules;
-    double silo_radius, orifice_radius, plate_z, plate_sphere_radius;
-    double dt, duration, sample_interval, fill_xi, fill_max_time;
-    int seed;
-} silo_yaml;
-
-#define F(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_DEFAULT, silo_yaml, member)
-static const cyaml_schema_field_t silo_fields[] = {
-    CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, silo_yaml, experiment, 1, 16),
-    F("median_diameter", median_diameter), F("geometric_sd", geometric_sd), F("truncation_sigmas", truncation_sigmas),
-    F("density", density), F("k_n", k_n), F("k_s", k_s), F("wall_k_n", wall_k_n), F("wall_k_s", wall_k_s), F("xi", xi),
-    F("mu_s", mu_s), CYAML_FIELD_INT("n_granules", CYAML_FLAG_DEFAULT, silo_yaml, n_granules),
-    F("silo_radius", silo_radius), F("orifice_radius", orifice_radius), F("plate_z", plate_z),
-    F("plate_sphere_radius", plate_sphere_radius), F("dt", dt), F("duration", duration),
-    F("sample_interval", sample_interval), F("fill_xi", fill_xi), F("fill_max_time", fill_max_time),
-    CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, silo_yaml, seed), CYAML_FIELD_END};
-#undef F
-static const cyaml_schema_value_t silo_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, silo_yaml, silo_fields)};
-
-int exp_is_silo_config(const char *path) { return exp_yaml_starts_with(path, "experiment: silo"); }
-
-static void to_def(const silo_yaml *y, exp_silo_def *d)
-{
-    *d = exp_default_silo_def();
-    d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
-    d->density = y->density;
-    // Table A.2: no rolling (k_r = μ_r = 0), one damping ratio for all contacts.
-    d->granule = (dem_contact_params){.k_n = y->k_n, .k_s = y->k_s, .xi = y->xi, .mu_s = y->mu_s, .damping = EXP_DAMPING_DEFAULT};
-    d->wall = (dem_contact_params){
-        .k_n = y->wall_k_n, .k_s = y->wall_k_s, .xi = y->xi, .mu_s = y->mu_s, .damping = EXP_DAMPING_DEFAULT};
-    d->n_granules = y->n_granules > 0 ? (size_t)y->n_granules : 0;
-    d->silo_radius = y->silo_radius, d->orifice_radius = y->orifice_radius, d->plate_z = y->plate_z;
-    d->plate_sphere_radius = y->plate_sphere_radius;
-    d->dt = y->dt, d->duration = y->duration, d->sample_interval = y->sample_interval;
-    d->fill_xi = y->fill_xi, d->fill_max_time = y->fill_max_time, d->seed = (uint64_t)y->seed;
-}
-
-static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
-{
-    const exp_set_key keys[] = {
-        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("xi", &y->xi),
-        EXP_SET_NUMBER("dt", &y->dt), EXP_SET_NUMBER("duration", &y->duration),
-        EXP_SET_NUMBER("orifice_radius", &y->orifice_radius), EXP_SET_NUMBER("silo_radius", &y->silo_radius),
-        EXP_SET_NUMBER("plate_z", &y->plate_z), EXP_SET_INTEGER("n_granules", &y->n_granules),
-        EXP_SET_INTEGER("seed", &y->seed), EXP_SET_REFUSED("mu_r", "the silo benchmark has no rolling resistance")};
-    return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
-}
-
-static silo_yaml *load_config(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len)
-{
-    silo_yaml *y = NULL;
-    if (exp_yaml_load(path, &silo_schema, (void **)&y, "check the keys and value types against configs/silo.yaml", err, len)) return NULL;
-    int bad = 0;
-    char msg[300];
-    for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
-    if (!bad && strcmp(y->experiment, "silo") != 0) {
-        int line = exp_yaml_line_of(path, "experiment", 1);
-        bad = exp_fail(err, len, "%s:%d: experiment: must be silo", path, line);
-    }
-    if (!bad && y->n_granules < 1) {
-        int line = exp_yaml_line_of(path, "n_granules", 1);
-        bad = exp_fail(err, len, "%s:%d: n_granules: %d must be >= 1", path, line, y->n_granules);
-    }
-    if (!bad) {
-        to_def(y, d);
-        if (exp_silo_check(d, msg, sizeof msg)) {
-            char field[EXP_FIELD_LEN];
-            const char *leaf = exp_message_field(msg, field);
-            // granule_contact.k_n: the YAML key is k_n, wall_contact.k_n is wall_k_n.
-            char key[64];
-            snprintf(key, sizeof key, "%s%s", strncmp(field, "wall_contact", 12) == 0 ? "wall_" : "", leaf);
-            int line = exp_yaml_line_of(path, key, 1);
-            bad = line > 0 ? exp_fail(err, len, "%s:%d: %s: %s", path, line, key, msg)
-                           : exp_fail(err, len, "%s: %s: %s", path, key, msg);
-        }
-    }
-    if (bad) {
-        exp_yaml_free(&silo_schema, y);
-        return NULL;
-    }
-    return y;
-}
-
-static void write_json(FILE *f, const exp_silo_def *d, const exp_silo_result *r, const dem_world *w, const char *status)
-{
-    char effects[1024];
-    dem_world_describe_features(w, effects, sizeof effects);
-    const exp_silo_sample *last = r->n_series ? &r->series[r->n_series - 1] : NULL;
-    // Time at which half and 90 % of the granules were below the plate.
-    double t50 = NAN, t90 = NAN;
-    for (size_t k = 0; k < r->n_series; ++k) {
-        if (isnan(t50) && r->series[k].discharged * 2 >= r->granules) t50 = r->series[k].t;
-        if (isnan(t90) && r->series[k].discharged * 10 >= r->granules * 9) t90 = r->series[k].t;
-    }
-    char s50[32], s90[32]; // JSON has no NaN: null when not reached
-    snprintf(s50, sizeof s50, isnan(t50) ? "null" : "%.3f", t50);
-    snprintf(s90, sizeof s90, isnan(t90) ? "null" : "%.3f", t90);
-    fprintf(f,
-            "{\"experiment\": \"silo\", \"status\": \"%s\", \"granules\": %zu, \"plate_spheres\": %zu, \"seed\": %llu, "
-            "\"dt_s\": %.6g, \"simulated_time_s\": %.4f, \"fill_time_s\": %.3f, \"wall_time_s\": %.2f, "
-            "\"particle_steps\": %llu, \"orifice_clear_radius_m\": %.3f, \"final_contacts\": %zu, \"final_ke_J\": %.6g, \"discharged_final\": %zu, "
-            "\"t_half_discharged_s\": %s, \"t_90_discharged_s\": %s, \"effects\": \"%s\"}\n",
-            status, r->granules, r->plate_spheres, (unsigned long long)d->seed, dem_world_dt(w), last ? last->t : 0.0,
-            r->fill_time_s, r->wall_time_s, r->particle_steps, plate_inner_ring(d) - d->plate_sphere_radius, last ? last->contacts : 0,
-            last ? last->ke_translational + last->ke_rotational : 0.0, last ? last->discharged : 0, s50, s90, effects);
-}
-
-int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out)
-{
-    char err[1400], dir[1024], p[1200];
-    exp_silo_def d;
-    silo_yaml *y = load_config(path, n_sets, sets, &d, err, sizeof err);
-    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    exp_yaml_free(&silo_schema, y);
-    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/silo");
-    if (exp_mkdirs(dir, err, sizeof err)) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    exp_progress_printer ps = {.scene = "silo", .start = exp_wall_seconds()};
-    size_t plate = 0;
-    dem_world *w = exp_silo_prepare(&d, exp_print_progress, &ps, &plate, err, sizeof err);
-    if (!w) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    double fill_wall = exp_wall_seconds() - ps.start;
-    if (dem_world_prepare(w) != DEM_OK) {
-        fprintf(stderr, "granucal simulate: silo: %s\n", dem_world_error(w));
-        dem_world_destroy(w);
-        return 1;
-    }
-    snprintf(p, sizeof p, "%s/silo_initial.data", dir);
-    int bad = exp_silo_write_liggghts_data(p, w, &d, plate, err, sizeof err);
-    fprintf(stderr, "granucal simulate: silo filled (%zu granules, %zu plate spheres) in %.0f s; %s\n",
-            dem_world_granules(w).count - plate, plate, fill_wall, dem_world_dt_report(w));
-    exp_silo_result r;
-    double t0 = exp_wall_seconds();
-    dem_status st = exp_silo_discharge(w, &d, plate, exp_print_progress, &ps, &r);
-    r.wall_time_s = exp_wall_seconds() - t0;
-    r.fill_time_s = fill_wall;
-    if (st != DEM_OK) fprintf(stderr, "granucal simulate: silo: %s\n", dem_world_error(w));
-    char prefix[1100];
-    snprintf(p, sizeof p, "%s/series.csv", dir);
-    snprintf(prefix, sizeof prefix, "%s/", dir);
-    bad = bad || exp_silo_write_series(&r, p, prefix, err, sizeof err);
-    if (!bad) bad = exp_result_write_h5(dir, w, err, sizeof err);
-    const char *status = st == DEM_OK ? "ok" : "failed";
-    if (!bad) {
-        char tmp[1300];
-        snprintf(p, sizeof p, "%s/result.json", dir);
-        snprintf(tmp, sizeof tmp, "%s.tmp", p);
-        FILE *f = fopen(tmp, "w");
-        if (f) write_json(f, &d, &r, w, status);
-        bad = !f || fclose(f) != 0 || rename(tmp, p) != 0;
-        if (bad) snprintf(err, sizeof err, "cannot write '%s'", p);
-    }
-    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
-    write_json(stdout, &d, &r, w, status);
-    exp_silo_result_free(&r);
-    dem_world_destroy(w);
-    return bad || st != DEM_OK;
 }

@@ -97,11 +97,8 @@ int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp
 int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const char *png_prefix, char *err,
                           size_t len);
 
-int exp_is_silo_config(const char *path);
-
-/// `granucal simulate configs/silo.yaml [--set k=v ...] [--out DIR]`: JSON
-/// on stdout; DIR gets result.json, result.h5 (final frame), series.csv,
-/// contacts.png, kinetic_energy.png and silo_initial.data (for LIGGGHTS).
-int exp_silo_simulate(const char *path, int n_sets, char **sets, const char *out);
+/// The orifice's clear radius: the innermost ring of plate spheres' centres
+/// less a sphere's radius.
+double exp_silo_orifice_clear_radius(const exp_silo_def *d);
 
 #endif
