@@ -3,7 +3,6 @@
 // strike off, settle, cycle the piston between two pressures, E' (eq. 19).
 #include "exp_compress.h"
 
-#include <cyaml/cyaml.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -16,8 +15,6 @@
 #include "exp_contact_rules.h"
 #include "exp_plot.h"
 #include "exp_pour.h"
-#include "exp_result.h"
-#include "exp_yaml.h"
 
 #define FILL_GRAVITY 30.0 // pour and settle under 30 g (see exp_compress_run)
 // exp_ke_ratio divides by (bed mass)·9.81·d50: the thresholds carry the
@@ -409,166 +406,5 @@ int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path,
                         .ylabel = "force (N)"};
     int rc = exp_plot_png(png_path, &ax, (size_t)ns, series, 900, 600, err, len);
     free(x), free(y), free(series), free(labels);
-    return rc;
-}
-
-// ------------------------------------------------------------ config + CLI
-
-typedef struct compress_yaml {
-    char *experiment;
-    double diameter, depth, density, median_diameter, geometric_sd, truncation_sigmas, lambda;
-    double k_n, xi, mu_s, wall_mu_s;
-    char *damping;
-    double sigma_min, sigma_max, piston_speed, max_time;
-    int cycles, seed;
-} compress_yaml;
-
-#define F(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_DEFAULT, compress_yaml, member)
-static const cyaml_schema_field_t compress_fields[] = {
-    CYAML_FIELD_STRING_PTR("experiment", CYAML_FLAG_POINTER, compress_yaml, experiment, 1, 16),
-    F("diameter", diameter), F("depth", depth), F("density", density), F("median_diameter", median_diameter),
-    F("geometric_sd", geometric_sd), F("truncation_sigmas", truncation_sigmas), F("lambda", lambda), F("k_n", k_n),
-    F("xi", xi), F("mu_s", mu_s), F("wall_mu_s", wall_mu_s),
-    CYAML_FIELD_STRING_PTR("damping", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, compress_yaml, damping, 1, 32),
-    F("sigma_min", sigma_min), F("sigma_max", sigma_max), F("piston_speed", piston_speed), F("max_time", max_time),
-    CYAML_FIELD_INT("cycles", CYAML_FLAG_DEFAULT, compress_yaml, cycles),
-    CYAML_FIELD_INT("seed", CYAML_FLAG_DEFAULT, compress_yaml, seed), CYAML_FIELD_END};
-#undef F
-static const cyaml_schema_value_t compress_schema = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, compress_yaml, compress_fields)};
-
-int exp_is_compress_config(const char *path) { return exp_yaml_starts_with(path, "experiment: compression"); }
-
-static int to_def(const compress_yaml *y, exp_compress_def *d, char *err, size_t len)
-{
-    *d = exp_default_compress_def();
-    d->diameter = y->diameter, d->depth = y->depth, d->density = y->density, d->lambda = y->lambda;
-    d->gsd = dem_gsd_lognormal(y->median_diameter, y->geometric_sd, y->truncation_sigmas);
-    dem_damping_mode mode;
-    if (exp_damping_from_name(y->damping, "damping", &mode, err, len)) return 1;
-    d->granule = exp_granule_pair(y->k_n, y->xi, y->mu_s, 0, mode); // no rolling here (μ_r = 0 switches it off)
-    d->wall = d->granule;
-    d->wall.mu_s = y->wall_mu_s;
-    d->sigma_min = y->sigma_min, d->sigma_max = y->sigma_max, d->piston_speed = y->piston_speed;
-    d->max_time = y->max_time, d->cycles = y->cycles, d->seed = (uint64_t)y->seed;
-    return 0;
-}
-
-static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
-{
-    const exp_set_key keys[] = {
-        EXP_SET_NUMBER("k_n", &y->k_n), EXP_SET_NUMBER("mu_s", &y->mu_s), EXP_SET_NUMBER("wall_mu_s", &y->wall_mu_s),
-        EXP_SET_NUMBER("xi", &y->xi), EXP_SET_NUMBER("lambda", &y->lambda), EXP_SET_INTEGER("seed", &y->seed),
-        EXP_SET_NUMBER("sigma_min", &y->sigma_min), EXP_SET_NUMBER("sigma_max", &y->sigma_max),
-        EXP_SET_NUMBER("piston_speed", &y->piston_speed), EXP_SET_INTEGER("cycles", &y->cycles),
-        EXP_SET_NUMBER("max_time", &y->max_time),
-        EXP_SET_REFUSED("mu_r", "the compression test has no rolling resistance")};
-    return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
-}
-
-static compress_yaml *load_config(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
-{
-    compress_yaml *y = NULL;
-    if (exp_yaml_load(path, &compress_schema, (void **)&y, "check the keys and value types against configs/compression.yaml", err, len)) return NULL;
-    char msg[300];
-    int bad = 0;
-    for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
-    if (!bad && strcmp(y->experiment, "compression") != 0) bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
-    if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
-        // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
-        char field[EXP_FIELD_LEN];
-        bad = exp_field_error(path, n_sets, sets, exp_message_field(msg, field), msg, err, len);
-    }
-    if (bad) {
-        exp_yaml_free(&compress_schema, y);
-        return NULL;
-    }
-    return y;
-}
-
-int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
-{
-    compress_yaml *y = load_config(path, n_sets, sets, d, err, len);
-    if (!y) return 1;
-    exp_yaml_free(&compress_schema, y);
-    return 0;
-}
-
-static void write_json(FILE *f, const compress_yaml *y, const exp_compress_def *d, const exp_compress_result *r,
-                       const dem_world *w, const char *status, double wall)
-{
-    char effects[1024];
-    dem_world_describe_features(w, effects, sizeof effects);
-    fprintf(f,
-            "{\"experiment\": \"compression\", \"status\": \"%s\", \"k_n\": %g, \"mu_s\": %g, \"wall_mu_s\": %g, "
-            "\"lambda\": %g, \"seed\": %d, \"sigma_min_Pa\": %g, \"sigma_max_Pa\": %g, \"piston_speed_m_s\": %g, "
-            "\"e_confined_Pa\": %.6g, \"e_confined_loading_Pa\": %.6g, \"stable\": %s, \"cycles\": [",
-            status, y->k_n, y->mu_s, y->wall_mu_s, y->lambda, y->seed, d->sigma_min, d->sigma_max, d->piston_speed,
-            r->e_confined, r->e_confined_loading, r->stable ? "true" : "false");
-    for (int k = 0; k < r->n_cycles; ++k) {
-        const exp_compress_cycle *c = &r->cycle[k];
-        fprintf(f,
-                "%s{\"e_loading_Pa\": %.6g, \"e_unloading_Pa\": %.6g, \"strain_start\": %.6g, \"strain_turn\": %.6g, "
-                "\"strain_end\": %.6g, \"permanent_strain\": %.6g, \"work_in_J\": %.6g, \"work_out_J\": %.6g}",
-                k ? ", " : "", c->e_loading, c->e_unloading, c->strain_start, c->strain_turn, c->strain_end,
-                c->permanent_strain, c->work_in, c->work_out);
-    }
-    fprintf(f,
-            "], \"bed_height_m\": %.6g, \"solid_fraction\": %.4f, \"coordination_at_sigma_max\": %.3f, "
-            "\"max_ke_over_elastic\": %.3g, \"granules\": %zu, \"fill_time_s\": %.4f, \"simulated_time_s\": %.4f, "
-            "\"wall_time_s\": %.2f, \"particle_steps\": %llu, \"dt_s\": %.6g, \"effects\": \"%s\"}\n",
-            r->bed_height, r->solid_fraction, r->coordination_turn, r->max_ke_over_elastic, r->granules, r->fill_time_s,
-            r->simulated_time_s, wall, r->particle_steps, dem_world_dt(w), effects);
-}
-
-static int write_outputs(const char *dir, const compress_yaml *y, const exp_compress_def *d,
-                         const exp_compress_result *r, const dem_world *w, double wall)
-{
-    char path[1100], png[1100], err[1200], tmp[1200];
-    snprintf(path, sizeof path, "%s/curve.csv", dir);
-    snprintf(png, sizeof png, "%s/force_displacement.png", dir);
-    int bad = exp_compress_write_curve(r, path, png, err, sizeof err);
-    if (!bad) bad = exp_result_write_h5(dir, w, err, sizeof err);
-    if (!bad) {
-        snprintf(path, sizeof path, "%s/result.json", dir);
-        snprintf(tmp, sizeof tmp, "%s.tmp", path);
-        FILE *f = fopen(tmp, "w");
-        if (f) write_json(f, y, d, r, w, r->stable ? "ok" : "not stable", wall);
-        bad = !f || fclose(f) != 0 || rename(tmp, path) != 0;
-        if (bad) snprintf(err, sizeof err, "cannot write '%s'", path);
-    }
-    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
-    return bad;
-}
-
-int exp_compress_simulate(const char *path, int n_sets, char **sets, const char *out)
-{
-    char err[1024], dir[1024];
-    exp_compress_def d;
-    compress_yaml *y = load_config(path, n_sets, sets, &d, err, sizeof err);
-    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    snprintf(dir, sizeof dir, "%s", out ? out : "results/runs/compression");
-    if (exp_mkdirs(dir, err, sizeof err)) {
-        fprintf(stderr, "granucal simulate: %s\n", err);
-        exp_yaml_free(&compress_schema, y);
-        return 1;
-    }
-    exp_progress_printer p = {.scene = "compression", .start = exp_wall_seconds()};
-    exp_compress_result r;
-    dem_world *w = exp_compress_run(&d, exp_print_progress, &p, &r, err, sizeof err);
-    int rc = 1;
-    if (!w) {
-        fprintf(stderr, "granucal simulate: %s\n", err);
-        printf("{\"experiment\": \"compression\", \"status\": \"failed\", \"error\": \"%s\"}\n", err);
-    } else {
-        double wall = exp_wall_seconds() - p.start;
-        fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));
-        int bad = write_outputs(dir, y, &d, &r, w, wall);
-        write_json(stdout, y, &d, &r, w, r.stable ? "ok" : "not stable", wall);
-        rc = bad;
-    }
-    exp_compress_result_free(&r);
-    dem_world_destroy(w);
-    exp_yaml_free(&compress_schema, y);
     return rc;
 }

@@ -109,19 +109,4 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
 int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
                              size_t len);
 
-/// 1 if the file is a compression config (first key `experiment: compression`).
-int exp_is_compress_config(const char *path);
-
-/// Load a compression config with `--set` overrides ("key=value": k_n, mu_s,
-/// wall_mu_s, xi, lambda, seed, sigma_min, sigma_max, piston_speed, cycles,
-/// max_time) into a definition. Non-zero with a message naming the file,
-/// line and field.
-int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len);
-
-/// `granucal simulate configs/compression.yaml [--set k=v ...] [--out DIR]`:
-/// load, validate (errors name file, line, field), run, print one JSON
-/// object on stdout and write DIR/result.json, result.h5, curve.csv and
-/// force_displacement.png. Returns the process exit status.
-int exp_compress_simulate(const char *path, int n_sets, char **sets, const char *out);
-
 #endif
