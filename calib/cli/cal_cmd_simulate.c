@@ -6,6 +6,7 @@
 #include <libgen.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cal_commands.h"
@@ -19,6 +20,7 @@
 #include "exp_cylinder_config.h"
 #include "exp_cylinder_runner.h"
 #include "exp_drum_config.h"
+#include "exp_drum_runner.h"
 #include "exp_scene.h"
 #include "exp_silo_config.h"
 #include "exp_silo_runner.h"
@@ -205,33 +207,69 @@ static int run_scene_file(const char *path, const simulate_args *a)
     return rc;
 }
 
-// The experiments' runners, one per experiment: each loads its config into
-// definitions (exp_NAME_load) and hands them to the experiment's runner. The
-// drum's runner is calib's own (cal_simulate_drum.c: its checkpoints are
-// keyed like the calibration's store, and it takes --rpm-list and
-// --checkpoint-every); the others live with their experiment
-// (experiments/NAME/), which knows nothing of calib. Compression and the silo
-// still load their config in their runner (one file each, not yet split).
+// The experiments' runners, one per experiment and all of one shape: load
+// the config into its definition (exp_NAME_load, its message on stderr) and
+// hand it to the experiment's runner, exp_NAME_simulate(def, out_dir, ...)
+// (experiments/NAME/exp_NAME_runner.h), which knows nothing of calib. The
+// drum's takes what only it has: --rpm-list, read here, and
+// --checkpoint-every, its checkpoints labelled with the calibration's record
+// key (drum_key).
+static int load_failed(const char *err) { return fprintf(stderr, "granucal simulate: %s\n", err), 1; }
+
+static int parse_rpm_list(const char *list, double *rpm, int cap, char *err, size_t len)
+{
+    int n = 0;
+    const char *p = list;
+    while (*p && n < cap) {
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || !(v >= 0 && v <= 1000) || (*end && *end != ','))
+            return snprintf(err, len, "--rpm-list '%s': expected numbers in [0, 1000] separated by commas", list), -1;
+        rpm[n++] = v;
+        p = *end ? end + 1 : end;
+    }
+    return n;
+}
+
+// A drum turn's checkpoint label: the calibration's record key of the same
+// run (a drum filled and turned with one pair, at run->rpm).
+static void drum_key(const exp_drum_def *def, const exp_drum_run_opts *run, char *out, size_t len)
+{
+    const cal_drum_case whole = {.def = *def, .fill = *def, .run = *run};
+    cal_drum_key(&whole, run->rpm, out, len);
+}
+
 static int run_drum(const char *path, const simulate_args *a)
 {
     char err[1024];
     exp_drum_yaml *y = exp_drum_config_load(path, a->n_sets, a->sets, err, sizeof err);
-    if (!y) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    int rc = cal_simulate_drum(y, a->out, a->rpm_list, a->checkpoint_every_s);
+    if (!y) return load_failed(err);
+    double rpm[CAL_CASE_MAX_RPM];
+    exp_drum_simulate_opts o = {.rpm = rpm, .checkpoint_every_s = a->checkpoint_every_s, .key = drum_key};
+    o.n_rpm = a->rpm_list ? parse_rpm_list(a->rpm_list, rpm, CAL_CASE_MAX_RPM, err, sizeof err) : 0;
+    int rc = o.n_rpm < 0 ? (fprintf(stderr, "granucal simulate: %s\n", err), 2) : exp_drum_simulate(y, a->out, &o);
     exp_drum_config_free(y);
     return rc;
 }
 static int run_compress(const char *path, const simulate_args *a)
 {
-    return exp_compress_simulate(path, a->n_sets, a->sets, a->out);
+    char err[1400];
+    exp_compress_def d;
+    if (exp_compress_load(path, a->n_sets, a->sets, &d, err, sizeof err)) return load_failed(err);
+    return exp_compress_simulate(&d, a->out);
 }
-static int run_silo(const char *path, const simulate_args *a) { return exp_silo_simulate(path, a->n_sets, a->sets, a->out); }
+static int run_silo(const char *path, const simulate_args *a)
+{
+    char err[1400];
+    exp_silo_def d;
+    if (exp_silo_load(path, a->n_sets, a->sets, &d, err, sizeof err)) return load_failed(err);
+    return exp_silo_simulate(&d, a->out);
+}
 static int run_cylinder(const char *path, const simulate_args *a)
 {
     char err[1400];
     exp_cylinder_def d;
-    if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err))
-        return fprintf(stderr, "granucal simulate: %s\n", err), 1;
+    if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err)) return load_failed(err);
     return exp_cylinder_simulate(&d, a->out);
 }
 

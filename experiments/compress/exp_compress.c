@@ -1,19 +1,17 @@
 // SPDX-License-Identifier: MIT
 // The confined compression test (sections 3.2.1, 4.1): pour into the die,
 // strike off, settle, cycle the piston between two pressures, E' (eq. 19).
+// The physics only: its config is exp_compress_config.c, its runner (the
+// files it writes) exp_compress_runner.c.
 #include "exp_compress.h"
 
-#include <errno.h>
-#include <stdarg.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
 
 #include "dem_scaling.h"
 #include "exp_contact_rules.h"
-#include "exp_plot.h"
 #include "exp_pour.h"
 
 #define FILL_GRAVITY 30.0 // pour and settle under 30 g (see exp_compress_run)
@@ -360,51 +358,4 @@ dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress,
     for (size_t i = 0; i < g.count; ++i) solid += 4.0 / 3.0 * DEM_PI * g.radius[i] * g.radius[i] * g.radius[i];
     out->solid_fraction = solid / (DEM_PI * r * r * out->bed_height);
     return w;
-}
-
-// ------------------------------------------------------------------ output
-
-int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
-                             size_t len)
-{
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
-    // The engine's axial totals come last, so the columns before keep their places.
-    fprintf(f, "t_s,cycle,loading,piston_y_m,displacement_m,strain,force_top_N,force_bottom_N,force_side_normal_N,"
-               "sigma_Pa,ke_over_elastic,piston_axial_total_N,floor_axial_total_N,side_axial_total_N\n");
-    for (size_t k = 0; k < r->n_curve; ++k) {
-        const exp_compress_sample *s = &r->curve[k];
-        fprintf(f, "%.6g,%d,%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%.6g,%.6g,%.6g\n", s->t, s->cycle, s->loading,
-                s->piston_y, s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic,
-                s->f_piston_axial, s->f_floor_axial, s->f_side_axial);
-    }
-    if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
-    if (!png_path) return 0;
-    // One series per cycle, displacement in mm against the piston force.
-    int nc = r->n_cycles > 0 ? r->n_cycles : 1;
-    size_t n = r->n_curve;
-    double *x = malloc((n + 1) * sizeof *x), *y = malloc((n + 1) * sizeof *y);
-    exp_plot_series *series = calloc((size_t)nc + 1, sizeof *series);
-    char (*labels)[32] = calloc((size_t)nc + 1, sizeof *labels);
-    if (!x || !y || !series || !labels) return free(x), free(y), free(series), free(labels), exp_fail(err, len, "out of memory");
-    size_t used = 0;
-    int ns = 0;
-    for (int c = 1; c <= nc; ++c) {
-        size_t first = used;
-        for (size_t k = 0; k < n; ++k)
-            if (r->curve[k].cycle == c && r->curve[k].displacement != 0)
-                x[used] = 1e3 * r->curve[k].displacement, y[used++] = r->curve[k].f_top;
-        if (used == first) continue;
-        snprintf(labels[ns], sizeof labels[ns], "cycle %d", c);
-        series[ns] = (exp_plot_series){.n = used - first, .x = x + first, .y = y + first, .label = labels[ns]};
-        exp_plot_colour(c - 1, series[ns].rgb);
-        ns++;
-    }
-    exp_plot_axes ax = {.title = "Confined compression: force on the piston", .xlabel = "piston displacement (mm)",
-                        .ylabel = "force (N)"};
-    int rc = exp_plot_png(png_path, &ax, (size_t)ns, series, 900, 600, err, len);
-    free(x), free(y), free(series), free(labels);
-    return rc;
 }

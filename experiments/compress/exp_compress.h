@@ -11,6 +11,9 @@
 /// Effects: no rolling resistance (μ_r = 0 for granules and walls, so the
 /// engine switches the rolling spring off); tangential friction and the
 /// normal dashpot on. Section 4.1 sets the granule–die friction to 0.2.
+///
+/// The physics only: exp_compress_config.h loads a definition from YAML,
+/// exp_compress_runner.h runs it and writes its files.
 #ifndef EXP_COMPRESS_H
 #define EXP_COMPRESS_H
 
@@ -104,9 +107,5 @@ void exp_compress_result_free(exp_compress_result *r);
 /// side wall 0.
 dem_world *exp_compress_run(const exp_compress_def *d, exp_progress_fn progress, void *ctx, exp_compress_result *out,
                             char *err, size_t len);
-
-/// Write the curve as CSV and the force–displacement PNG. 0 or a message.
-int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
-                             size_t len);
 
 #endif

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The compression test's configuration file (configs/compression.yaml) to its
-// definition, with located errors (exp_compress_config.h).
+// The confined compression test as a YAML file: load, --set, validate. See
+// exp_compress_config.h; its runner is exp_compress_runner.c.
 #include "exp_compress_config.h"
 
 #include <cyaml/cyaml.h>
@@ -65,11 +65,19 @@ static int apply_set(compress_yaml *y, const char *set, char *err, size_t len)
 int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_def *d, char *err, size_t len)
 {
     compress_yaml *y = NULL;
-    if (exp_yaml_load(path, &compress_schema, (void **)&y, "check the keys and value types against configs/compression.yaml", err, len)) return 1;
+    if (exp_yaml_load(path, &compress_schema, (void **)&y,
+                      "check the keys and value types against configs/compression.yaml", err, len))
+        return 1;
     char msg[300];
     int bad = 0;
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
-    if (!bad && strcmp(y->experiment, "compression") != 0) bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
+    if (!bad && strcmp(y->experiment, "compression") != 0)
+        bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
+    // The seed is a uint64_t of the definition: a negative one would wrap.
+    if (!bad && y->seed < 0) {
+        snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
+        bad = exp_field_error(path, 0, NULL, "seed", msg, err, len);
+    }
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
         // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
         char field[EXP_FIELD_LEN];
@@ -78,5 +86,3 @@ int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_de
     exp_yaml_free(&compress_schema, y);
     return bad;
 }
-
-

@@ -1,16 +1,14 @@
 // SPDX-License-Identifier: MIT
-// The silo discharge benchmark (Appendix A.2, Table A.2).
+// The silo discharge benchmark (Appendix A.2, Table A.2): the physics only.
+// Its config is exp_silo_config.c, its runner (the files it writes)
+// exp_silo_runner.c.
 #include "exp_silo.h"
 
-#include <errno.h>
-#include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
 
 #include "exp_contact_rules.h"
-#include "exp_plot.h"
 
 exp_silo_def exp_default_silo_def(void)
 {
@@ -127,7 +125,7 @@ static long add_rings(dem_world *w, const exp_silo_def *d, double outer, double 
 }
 
 // Radius of the innermost ring of the plate: the orifice's clear radius is
-// this less a (exp_silo_orifice_clear_radius).
+// this less a.
 static double plate_inner_ring(const exp_silo_def *d)
 {
     double a = d->plate_sphere_radius, outer = d->silo_radius - a, rho = outer;
@@ -156,9 +154,8 @@ static dem_world *fill(const exp_silo_def *d, exp_progress_fn progress, void *ct
     gg.xi = gw.xi = d->fill_xi;
     dem_world *w = create_vessel(d, &gg, &gw, err, len);
     if (!w) return NULL;
-    double a = d->plate_sphere_radius, inner = plate_inner_ring(d);
+    double a = d->plate_sphere_radius;
     long plate = add_rings(w, d, d->silo_radius - a, 0, 1); // closed: the gate fills the orifice
-    (void)inner;
     double *diam = malloc(d->n_granules * sizeof *diam);
     if (plate < 0 || !diam || dem_gsd_sample(&d->gsd, d->seed, d->n_granules, diam)) {
         exp_fail(err, len, "silo fill: %s", plate < 0 ? dem_world_error(w) : "cannot sample sizes");
@@ -272,63 +269,4 @@ dem_status exp_silo_discharge(dem_world *w, const exp_silo_def *d, size_t plate_
     }
     out->particle_steps = (unsigned long long)done * dem_world_granules(w).count;
     return st;
-}
-
-// ------------------------------------------------------------------ output
-
-int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp_silo_def *d, size_t plate_spheres,
-                                 char *err, size_t len)
-{
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
-    dem_granules_view g = dem_world_granules(w);
-    double r = d->silo_radius;
-    fprintf(f, "LIGGGHTS data file: silo discharge at t = 0 (granucal exp_silo; type 1 flowing, 2 plate)\n\n");
-    fprintf(f, "%zu atoms\n3 atom types\n\n", g.count);
-    fprintf(f, "%.6f %.6f xlo xhi\n%.6f %.6f ylo yhi\n%.6f %.6f zlo zhi\n\nAtoms\n\n", -1.2 * r, 1.2 * r, -1.2 * r, 1.2 * r,
-            -2.0, d->plate_z + 4 * (double)d->n_granules / (r * r) + 20);
-    // atom_style granular: atom-ID atom-type diameter density x y z
-    for (size_t i = 0; i < g.count; ++i) {
-        int plate = g.id[i] < plate_spheres;
-        fprintf(f, "%llu %d %.17g %.17g %.17g %.17g %.17g\n", (unsigned long long)g.id[i] + 1, plate ? 2 : 1,
-                2 * g.radius[i], d->density, g.position[i].x, g.position[i].y, g.position[i].z);
-    }
-    if (fclose(f) != 0 || rename(tmp, path) != 0) return exp_fail(err, len, "cannot write '%s'", path);
-    return 0;
-}
-
-int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const char *png_prefix, char *err, size_t len)
-{
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
-    fprintf(f, "t_s,contacts,wall_contacts,ke_translational_J,ke_rotational_J,ke_total_J,discharged,discharged_mass_kg\n");
-    for (size_t k = 0; k < r->n_series; ++k) {
-        const exp_silo_sample *s = &r->series[k];
-        fprintf(f, "%.4f,%zu,%zu,%.6g,%.6g,%.6g,%zu,%.6g\n", s->t, s->contacts, s->wall_contacts, s->ke_translational,
-                s->ke_rotational, s->ke_translational + s->ke_rotational, s->discharged, s->discharged_mass);
-    }
-    if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
-    if (!png_prefix) return 0;
-    size_t n = r->n_series;
-    double *t = malloc((n + 1) * sizeof *t), *c = malloc((n + 1) * sizeof *c), *ke = malloc((n + 1) * sizeof *ke);
-    if (!t || !c || !ke) return free(t), free(c), free(ke), exp_fail(err, len, "out of memory");
-    for (size_t k = 0; k < n; ++k)
-        t[k] = r->series[k].t, c[k] = (double)r->series[k].contacts,
-        ke[k] = r->series[k].ke_translational + r->series[k].ke_rotational;
-    char path[1200];
-    exp_plot_series s = {.n = n, .x = t, .y = c, .label = "granucal", .rgb = {0.12, 0.47, 0.71}};
-    exp_plot_axes ax = {.title = "Silo discharge: contacts (Fig. A.4)", .xlabel = "t (s)", .ylabel = "contacts"};
-    snprintf(path, sizeof path, "%scontacts.png", png_prefix);
-    int rc = exp_plot_png(path, &ax, 1, &s, 900, 500, err, len);
-    s.y = ke;
-    exp_plot_axes ax2 = {.title = "Silo discharge: kinetic energy (Fig. A.5)", .xlabel = "t (s)", .ylabel = "kinetic energy (J)",
-                         .log_y = 1};
-    snprintf(path, sizeof path, "%skinetic_energy.png", png_prefix);
-    if (!rc) rc = exp_plot_png(path, &ax2, 1, &s, 900, 500, err, len);
-    free(t), free(c), free(ke);
-    return rc;
 }

@@ -25,6 +25,9 @@
 ///    until at rest; then the discharge starts from that state in a fresh
 ///    world (no contact history, zero velocities) with Table A.2's contact,
 ///    gate removed — exactly the state written for LIGGGHTS.
+///
+/// The physics only: exp_silo_config.h loads a definition from YAML,
+/// exp_silo_runner.h runs it and writes its files.
 #ifndef EXP_SILO_H
 #define EXP_SILO_H
 
@@ -55,6 +58,10 @@ typedef struct exp_silo_def {
 exp_silo_def exp_default_silo_def(void);
 int exp_silo_check(const exp_silo_def *d, char *msg, size_t len);
 
+/// The orifice's clear radius the plate's rings leave (m): the innermost
+/// ring's radius less a plate sphere's, about d->orifice_radius.
+double exp_silo_orifice_clear_radius(const exp_silo_def *d);
+
 typedef struct exp_silo_sample {
     double t;
     size_t contacts;       ///< sphere–sphere contacts (granule–granule and granule–plate)
@@ -84,21 +91,5 @@ dem_world *exp_silo_prepare(const exp_silo_def *d, exp_progress_fn progress, voi
 /// Returns the engine status; the series so far is kept on a fault.
 dem_status exp_silo_discharge(dem_world *w, const exp_silo_def *d, size_t plate_spheres, exp_progress_fn progress,
                               void *ctx, exp_silo_result *out);
-
-/// Write the world's state as a LIGGGHTS data file (atom_style granular:
-/// id type diameter density x y z; flowing granules type 1, plate type 2).
-int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp_silo_def *d, size_t plate_spheres,
-                                 char *err, size_t len);
-
-/// Time series as CSV (t_s,contacts,wall_contacts,ke_translational_J,
-/// ke_rotational_J,ke_total_J,discharged,discharged_mass_kg) and PNGs of
-/// contacts and kinetic energy over time (png_prefix + "contacts.png",
-/// "kinetic_energy.png"; NULL for none).
-int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const char *png_prefix, char *err,
-                          size_t len);
-
-/// The orifice's clear radius: the innermost ring of plate spheres' centres
-/// less a sphere's radius.
-double exp_silo_orifice_clear_radius(const exp_silo_def *d);
 
 #endif

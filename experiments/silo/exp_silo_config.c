@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The silo's configuration file (configs/silo.yaml) to its definition, with
-// located errors (exp_silo_config.h).
+// The silo discharge benchmark as a YAML file: load, --set, validate. See
+// exp_silo_config.h; its runner is exp_silo_runner.c.
 #include "exp_silo_config.h"
 
 #include <cyaml/cyaml.h>
@@ -62,35 +62,36 @@ static int apply_set(silo_yaml *y, const char *set, char *err, size_t len)
     return exp_apply_set(set, keys, sizeof keys / sizeof *keys, err, len);
 }
 
+// The YAML key of a check's field: granule_contact.k_n is k_n,
+// wall_contact.k_n is wall_k_n (the file keeps the two pairs flat).
+static const char *yaml_key(const char *msg, char key[EXP_FIELD_LEN])
+{
+    char field[EXP_FIELD_LEN];
+    const char *leaf = exp_message_field(msg, field);
+    snprintf(key, EXP_FIELD_LEN, "%s%s", strncmp(field, "wall_contact", 12) == 0 ? "wall_" : "", leaf);
+    return key;
+}
+
 int exp_silo_load(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len)
 {
     silo_yaml *y = NULL;
-    if (exp_yaml_load(path, &silo_schema, (void **)&y, "check the keys and value types against configs/silo.yaml", err, len)) return 1;
+    if (exp_yaml_load(path, &silo_schema, (void **)&y, "check the keys and value types against configs/silo.yaml", err,
+                      len))
+        return 1;
     int bad = 0;
-    char msg[300];
+    char msg[300], key[EXP_FIELD_LEN];
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
-    if (!bad && strcmp(y->experiment, "silo") != 0) {
-        int line = exp_yaml_line_of(path, "experiment", 1);
-        bad = exp_fail(err, len, "%s:%d: experiment: must be silo", path, line);
-    }
+    if (!bad && strcmp(y->experiment, "silo") != 0)
+        bad = exp_field_error(path, 0, NULL, "experiment", "must be silo", err, len);
     if (!bad && y->n_granules < 1) {
-        int line = exp_yaml_line_of(path, "n_granules", 1);
-        bad = exp_fail(err, len, "%s:%d: n_granules: %d must be >= 1", path, line, y->n_granules);
+        snprintf(msg, sizeof msg, "n_granules = %d: must be >= 1", y->n_granules);
+        bad = exp_field_error(path, n_sets, sets, "n_granules", msg, err, len);
     }
     if (!bad) {
         to_def(y, d);
-        if (exp_silo_check(d, msg, sizeof msg)) {
-            char field[EXP_FIELD_LEN];
-            const char *leaf = exp_message_field(msg, field);
-            // granule_contact.k_n: the YAML key is k_n, wall_contact.k_n is wall_k_n.
-            char key[64];
-            snprintf(key, sizeof key, "%s%s", strncmp(field, "wall_contact", 12) == 0 ? "wall_" : "", leaf);
-            int line = exp_yaml_line_of(path, key, 1);
-            bad = line > 0 ? exp_fail(err, len, "%s:%d: %s: %s", path, line, key, msg)
-                           : exp_fail(err, len, "%s: %s: %s", path, key, msg);
-        }
+        if (exp_silo_check(d, msg, sizeof msg))
+            bad = exp_field_error(path, n_sets, sets, yaml_key(msg, key), msg, err, len);
     }
     exp_yaml_free(&silo_schema, y);
     return bad;
 }
-

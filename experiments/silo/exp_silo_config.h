@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file exp_silo_config.h
-/// The silo's configuration file (configs/silo.yaml: Table A.2's values)
-/// read into its definition, `--set key=value` applied, every error located
-/// by file and line.
+/// The silo discharge benchmark (exp_silo.h) as a YAML file,
+/// configs/silo.yaml, with `--set key=value` overrides, validated field by
+/// field; exp_silo_runner.h runs what it loads.
 #ifndef EXP_SILO_CONFIG_H
 #define EXP_SILO_CONFIG_H
 
@@ -10,11 +10,14 @@
 
 #include "exp_silo.h"
 
-/// Whether the file at path is a silo config (`experiment: silo` first).
+/// 1 if the file is a silo config (first key `experiment: silo`).
 int exp_is_silo_config(const char *path);
 
-/// Read path, apply sets[0..n_sets), check: 0 with *d filled, or 1 with a
-/// message naming the file, line and key in err.
+/// Load a silo config with `--set` overrides ("key=value": k_n, mu_s, xi,
+/// dt, duration, orifice_radius, silo_radius, plate_z, n_granules, seed)
+/// into a definition, checked (exp_silo_check). 0, or 1 with a message
+/// naming the file, line and YAML key ("FILE:LINE: KEY: problem"), or the
+/// `--set` that gave the bad value.
 int exp_silo_load(const char *path, int n_sets, char **sets, exp_silo_def *d, char *err, size_t len);
 
 #endif

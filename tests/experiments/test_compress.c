@@ -25,6 +25,7 @@
 #include <cmocka.h>
 
 #include "dem_scaling.h"
+#include "exp_compress.h"
 #include "exp_compress_config.h"
 
 static void shipped_config(char *path, size_t len)
