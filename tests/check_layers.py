@@ -64,7 +64,7 @@ LAYERS = (("engine", "dem_"), ("experiments", "exp_"), ("calib", "cal_"))
 # of experiments/ (methods on nothing: it knows no drum, config or store).
 EXP_COMMON = {"experiments/common"}
 EXP_TOOLS = {"experiments/image", "experiments/plot"}
-EXP_ALL = EXP_COMMON | EXP_TOOLS | {"experiments/" + e for e in ("scene", "cylinder", "drum", "compress", "silo")}
+EXP_ALL = EXP_COMMON | EXP_TOOLS | {"experiments/" + e for e in ("scene", "cylinder", "drum", "compress", "silo", "incline")}
 CAL_LADDER = ("calib/methods", "calib/inputs", "calib/runs", "calib/search", "calib/outputs", "calib/cli")
 FOLDERS = {
     "experiments/common": ("what the experiments share: pouring, contact rules, cost, size tables, YAML, "
@@ -76,6 +76,7 @@ FOLDERS = {
     "experiments/drum": ("the rotating drum", EXP_COMMON | EXP_TOOLS),
     "experiments/compress": ("confined compression", EXP_COMMON | EXP_TOOLS),
     "experiments/silo": ("silo discharge", EXP_COMMON | EXP_TOOLS),
+    "experiments/incline": ("a sphere on an inclined plane", EXP_COMMON | EXP_TOOLS),
     "calib/methods": ("numerical methods of the search: the two-fidelity map", set()),
     "calib/inputs": ("the config and the lab data", set(CAL_LADDER[:1]) | EXP_ALL),
     "calib/runs": ("the calibration's simulations through the store, workers, MPI, plan, progress, files",

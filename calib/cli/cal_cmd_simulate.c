@@ -21,6 +21,8 @@
 #include "exp_cylinder_runner.h"
 #include "exp_drum_config.h"
 #include "exp_drum_runner.h"
+#include "exp_incline_config.h"
+#include "exp_incline_runner.h"
 #include "exp_scene.h"
 #include "exp_silo_config.h"
 #include "exp_silo_runner.h"
@@ -55,6 +57,13 @@ static const char simulate_synopsis[] =
     "result.json and result.h5. --set overrides k_n, mu_s, mu_r, xi, lambda, seed,\n"
     "diameter, depth, density. Example:\n"
     "  granucal simulate configs/cylinder.yaml --set k_n=800 --set seed=2\n"
+    "\n"
+    "A sphere on an inclined plane (`experiment: incline`, configs/incline.yaml): one\n"
+    "granule let go on a plane tilted by angle_deg; prints its measured acceleration\n"
+    "and regime (rest, rolling, sliding) beside the textbook answer; DIR (default\n"
+    "results/runs/incline) gets result.json and result.h5. --set overrides angle_deg,\n"
+    "mu_s, mu_r, k_n, xi, diameter, density, duration. Example:\n"
+    "  granucal simulate configs/incline.yaml --set angle_deg=40 --set mu_s=0.1\n"
     "\n"
     "The confined compression test (configs/compression.yaml) and the silo discharge\n"
     "(configs/silo.yaml) take --set and --out the same way (see those files).\n";
@@ -272,6 +281,13 @@ static int run_cylinder(const char *path, const simulate_args *a)
     if (exp_cylinder_load(path, a->n_sets, a->sets, &d, err, sizeof err)) return load_failed(err);
     return exp_cylinder_simulate(&d, a->out);
 }
+static int run_incline(const char *path, const simulate_args *a)
+{
+    char err[1400];
+    exp_incline_def d;
+    if (exp_incline_load(path, a->n_sets, a->sets, &d, err, sizeof err)) return load_failed(err);
+    return exp_incline_simulate(&d, a->out);
+}
 
 // Every experiment `granucal simulate` runs: the first whose `claims` knows
 // the file (its first key, `experiment: NAME`) runs it; a file none claims
@@ -284,6 +300,7 @@ static const struct simulate_runner {
     {exp_is_compress_config, run_compress},
     {exp_is_silo_config, run_silo},
     {exp_is_cylinder_config, run_cylinder},
+    {exp_is_incline_config, run_incline},
 };
 
 enum { MAX_SETS = 64 };

@@ -87,21 +87,27 @@ void exp_cylinder_write_json(FILE *f, const exp_cylinder_def *d, const exp_cylin
             r->simulated_time_s, rep->wall_time_s, rep->particle_steps_est, dem_world_dt(w), effects);
 }
 
+// result.json's writer (exp_result_json_fn) over exp_cylinder_write_json.
+typedef struct cylinder_json {
+    const exp_cylinder_def *d;
+    const exp_cylinder_result *r;
+    const exp_cylinder_report *rep;
+    const dem_world *w;
+} cylinder_json;
+
+static void write_json(FILE *f, const void *ctx)
+{
+    const cylinder_json *j = ctx;
+    exp_cylinder_write_json(f, j->d, j->r, j->rep, j->w);
+}
+
 int exp_cylinder_write_outputs(const char *dir, const exp_cylinder_def *d, const exp_cylinder_result *r,
                                const exp_cylinder_report *rep, const dem_world *w, char *err, size_t len)
 {
-    char path[1100], tmp[1200];
+    const cylinder_json j = {d, r, rep, w};
     if (exp_mkdirs(dir, err, len)) return 1;
     if (exp_result_write_h5(dir, w, err, len)) return 1;
-    snprintf(path, sizeof path, "%s/result.json", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (f) exp_cylinder_write_json(f, d, r, rep, w);
-    if (!f || fclose(f) != 0 || rename(tmp, path) != 0) {
-        remove(tmp);
-        return exp_fail(err, len, "cannot write '%s'", path);
-    }
-    return 0;
+    return exp_result_write_json(dir, write_json, &j, err, len);
 }
 
 int exp_cylinder_simulate(const exp_cylinder_def *def, const char *out_dir)
@@ -115,12 +121,7 @@ int exp_cylinder_simulate(const exp_cylinder_def *def, const char *out_dir)
     dem_world *w = exp_cylinder_pour_and_report(&d, 1, &r, &rep, err, sizeof err);
     if (!w) {
         fprintf(stderr, "granucal simulate: %s\n", err);
-        printf("{\"experiment\": \"cylinder\", \"status\": \"failed\", \"error\": \"");
-        for (const char *c = err; *c; ++c) // a JSON string: escape quotes, backslashes, control characters
-            if (*c == '"' || *c == '\\') printf("\\%c", *c);
-            else if ((unsigned char)*c < 0x20) printf("\\u%04x", (unsigned)(unsigned char)*c);
-            else putchar(*c);
-        printf("\"}\n");
+        exp_result_print_failure("cylinder", err);
         return 1;
     }
     fprintf(stderr, "granucal simulate: %zu granules; %s\n", r.granules, dem_world_dt_report(w));

@@ -18,7 +18,7 @@ typedef struct exp_cylinder_report {
     double bed_top_m;           ///< highest granule top
 } exp_cylinder_report;
 
-/// Write DIR/result.json (atomically: a temporary file renamed) and
+/// Write DIR/result.json (exp_result_write_json: atomically) and
 /// DIR/result.h5 (the bed at rest, one frame) for a finished run, creating
 /// DIR. 0, or 1 with a message.
 int exp_cylinder_write_outputs(const char *dir, const exp_cylinder_def *d, const exp_cylinder_result *r,
