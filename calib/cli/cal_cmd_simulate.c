@@ -1,20 +1,14 @@
 // SPDX-License-Identifier: MIT
-// `granucal simulate FILE.yaml`: the one home of its runners. An experiment
-// config (drum, compression, silo, cylinder) goes to its runner through
-// simulate_runners; anything else is an explicit scene, run here and written
-// out frame by frame.
-#include <libgen.h>
-#include <stdint.h>
+// `granucal simulate FILE.yaml`: the command's options and the dispatch. An
+// experiment config (drum, compression, silo, cylinder, incline) goes to its
+// runner, experiments/NAME/exp_NAME_runner.h, through simulate_runners;
+// anything else is an explicit scene (exp_scene_runner.h).
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
+#include "cal_case_runs.h"
 #include "cal_commands.h"
 #include "cal_options.h"
-#include "cal_case_runs.h"
-#include "cal_files.h"
-#include "exp_common.h"
-#include "dem_output.h"
 #include "exp_compress_config.h"
 #include "exp_compress_runner.h"
 #include "exp_cylinder_config.h"
@@ -24,6 +18,7 @@
 #include "exp_incline_config.h"
 #include "exp_incline_runner.h"
 #include "exp_scene.h"
+#include "exp_scene_runner.h"
 #include "exp_silo_config.h"
 #include "exp_silo_runner.h"
 
@@ -85,98 +80,6 @@ static const char simulate_epilogue[] =
     "Example (the paper's verification test, Appendix A.1):\n"
     "  granucal simulate configs/scenes/verification_two_particles.yaml\n";
 
-typedef struct sim_outputs {
-    cal_atomic_file csv;
-    dem_h5_writer *h5;
-} sim_outputs;
-
-static void write_rows(FILE *f, const dem_world *w)
-{
-    dem_granules_view g = dem_world_granules(w);
-    double t = dem_world_time(w);
-    for (size_t i = 0; i < g.count; ++i)
-        fprintf(f, "%.10g,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t,
-                (unsigned long long)g.id[i] + 1, g.position[i].x, g.position[i].y, g.position[i].z, g.velocity[i].x,
-                g.velocity[i].y, g.velocity[i].z, g.omega[i].x, g.omega[i].y, g.omega[i].z);
-}
-
-static int write_frame(sim_outputs *o, const dem_world *w)
-{
-    write_rows(o->csv.f, w);
-    dem_granules_view g = dem_world_granules(w);
-    dem_diagnostics d = dem_world_diagnose(w);
-    return dem_h5_write_frame(o->h5, dem_world_time(w), &g, &d);
-}
-
-static int open_outputs(sim_outputs *o, const char *dir, char *err, size_t len)
-{
-    char path[1100];
-    if (cal_mkdirs(dir, err, len)) return 1;
-    snprintf(path, sizeof path, "%s/trajectory.csv", dir);
-    if (cal_atomic_open(&o->csv, path, err, len)) return 1;
-    fprintf(o->csv.f, "t,id,x,y,z,vx,vy,vz,wx,wy,wz\n");
-    snprintf(path, sizeof path, "%s/result.h5", dir);
-    o->h5 = dem_h5_open(path, err, len);
-    if (!o->h5) {
-        cal_atomic_abort(&o->csv);
-        return 1;
-    }
-    return 0;
-}
-
-// Run the scene, one frame per output interval; returns the engine status.
-static dem_status run_scene(const exp_scene *s, dem_world *w, sim_outputs *o, uint64_t *steps_done)
-{
-    double dt = dem_world_dt(w);
-    uint64_t per_frame = (uint64_t)(s->output_interval / dt + 0.5);
-    if (per_frame == 0) per_frame = 1;
-    uint64_t total = (uint64_t)(s->duration / dt + 0.5);
-    dem_status st = DEM_OK;
-    if (write_frame(o, w)) return DEM_ERR_INVALID;
-    for (*steps_done = 0; *steps_done < total && st == DEM_OK;) {
-        uint64_t n = total - *steps_done < per_frame ? total - *steps_done : per_frame;
-        st = dem_world_step(w, n);
-        *steps_done += n;
-        if (write_frame(o, w)) return DEM_ERR_INVALID;
-    }
-    return st;
-}
-
-static void summary_json(FILE *f, const exp_scene *s, const dem_world *w, dem_status st, uint64_t steps, double wall)
-{
-    char features[1024];
-    dem_world_describe_features(w, features, sizeof features);
-    dem_diagnostics d = dem_world_diagnose(w);
-    fprintf(f,
-            "{\"scene\": \"%s\", \"status\": \"%s\", \"granules\": %zu, \"dt_s\": %.6g, \"steps\": %llu, "
-            "\"simulated_time_s\": %.6g, \"wall_time_s\": %.3f, \"particle_steps\": %llu, "
-            "\"contacts\": %zu, \"wall_contacts\": %zu, \"ke_translational_J\": %.6g, \"ke_rotational_J\": %.6g, "
-            "\"effects\": \"%s\"",
-            s->name, st == DEM_OK ? "ok" : "failed", d.granules, dem_world_dt(w), (unsigned long long)steps,
-            dem_world_time(w), wall, (unsigned long long)(steps * d.granules), d.contacts, d.wall_contacts,
-            d.ke_translational, d.ke_rotational, features);
-    if (st != DEM_OK) fprintf(f, ", \"error\": \"%s\"", dem_world_error(w));
-    fprintf(f, "}\n");
-}
-
-static int finish(const char *dir, sim_outputs *o, const exp_scene *s, dem_world *w, dem_status st, uint64_t steps,
-                  double wall)
-{
-    char err[1024], path[1100];
-    int bad = cal_atomic_commit(&o->csv, err, sizeof err);
-    bad = bad || dem_h5_close(o->h5, err, sizeof err);
-    cal_atomic_file json;
-    snprintf(path, sizeof path, "%s/result.json", dir);
-    if (!bad && !cal_atomic_open(&json, path, err, sizeof err)) {
-        summary_json(json.f, s, w, st, steps, wall);
-        bad = cal_atomic_commit(&json, err, sizeof err);
-    }
-    if (bad) fprintf(stderr, "granucal simulate: %s\n", err);
-    summary_json(stdout, s, w, st, steps, wall);
-    if (st != DEM_OK) fprintf(stderr, "granucal simulate: run failed: %s\n", dem_world_error(w));
-    return bad || st != DEM_OK ? 1 : 0;
-}
-
 // What `granucal simulate` hands every runner: the options as given.
 typedef struct simulate_args {
     int n_sets;
@@ -186,36 +89,6 @@ typedef struct simulate_args {
     double checkpoint_every_s;
 } simulate_args;
 
-// The plain scene (granules and walls listed one by one): the runner when no
-// experiment claims the file.
-static int run_scene_file(const char *path, const simulate_args *a)
-{
-    if (a->n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
-    char err[1024], dir[1024];
-    exp_scene *s = exp_scene_load(path, err, sizeof err);
-    if (!s) return fprintf(stderr, "granucal simulate: %s\n", err), 1;
-    snprintf(dir, sizeof dir, "%s", a->out ? a->out : "");
-    if (!a->out) snprintf(dir, sizeof dir, "results/runs/%s", s->name);
-    dem_world *w = exp_scene_build(s, err, sizeof err);
-    if (!w) return fprintf(stderr, "granucal simulate: %s: %s\n", path, err), exp_scene_free(s), 1;
-    int rc = 1;
-    sim_outputs o = {0};
-    if (dem_world_prepare(w) != DEM_OK) {
-        fprintf(stderr, "granucal simulate: %s: %s\n", path, dem_world_error(w));
-    } else if (open_outputs(&o, dir, err, sizeof err)) {
-        fprintf(stderr, "granucal simulate: %s\n", err);
-    } else {
-        fprintf(stderr, "granucal simulate: %s\n", dem_world_dt_report(w));
-        double t0 = exp_wall_seconds();
-        uint64_t steps = 0;
-        dem_status st = run_scene(s, w, &o, &steps);
-        rc = finish(dir, &o, s, w, st, steps, exp_wall_seconds() - t0);
-    }
-    dem_world_destroy(w);
-    exp_scene_free(s);
-    return rc;
-}
-
 // The experiments' runners, one per experiment and all of one shape: load
 // the config into its definition (exp_NAME_load, its message on stderr) and
 // hand it to the experiment's runner, exp_NAME_simulate(def, out_dir, ...)
@@ -224,6 +97,20 @@ static int run_scene_file(const char *path, const simulate_args *a)
 // --checkpoint-every, its checkpoints labelled with the calibration's record
 // key (drum_key).
 static int load_failed(const char *err) { return fprintf(stderr, "granucal simulate: %s\n", err), 1; }
+
+// The plain scene (granules and walls listed one by one): the runner when no
+// experiment claims the file.
+static int run_scene_file(const char *path, const simulate_args *a)
+{
+    if (a->n_sets > 0) return fprintf(stderr, "granucal simulate: --set applies to experiment configs only\n"), 2;
+    char err[1024];
+    exp_scene *s = exp_scene_load(path, err, sizeof err);
+    if (!s) return load_failed(err);
+    int rc = exp_scene_simulate(s, a->out, path);
+    exp_scene_free(s);
+    return rc;
+}
+
 
 static int parse_rpm_list(const char *list, double *rpm, int cap, char *err, size_t len)
 {

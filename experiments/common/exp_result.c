@@ -2,44 +2,74 @@
 // An experiment's result.h5 and result.json (see exp_result.h).
 #include "exp_result.h"
 
+#include <errno.h>
 #include <stdio.h>
+#include <string.h>
 #include <unistd.h>
 
 #include "dem_output.h"
 #include "exp_common.h"
 
-int exp_result_write_h5(const char *dir, const dem_world *w, char *err, size_t len)
+dem_h5_writer *exp_result_h5_open(const char *dir, char *err, size_t len)
 {
     char path[1100];
     snprintf(path, sizeof path, "%s/result.h5", dir);
-    dem_h5_writer *h5 = dem_h5_open(path, err, len);
-    if (!h5) return 1;
+    return dem_h5_open(path, err, len);
+}
+
+int exp_result_h5_frame(dem_h5_writer *h5, const dem_world *w)
+{
     dem_granules_view g = dem_world_granules(w);
     dem_diagnostics d = dem_world_diagnose(w);
-    int bad = dem_h5_write_frame(h5, dem_world_time(w), &g, &d) ||
-              dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
+    return dem_h5_write_frame(h5, dem_world_time(w), &g, &d);
+}
+
+int exp_result_write_h5(const char *dir, const dem_world *w, char *err, size_t len)
+{
+    dem_h5_writer *h5 = exp_result_h5_open(dir, err, len);
+    if (!h5) return 1;
+    int bad = exp_result_h5_frame(h5, w) || dem_h5_write_attribute_string(h5, "dt_report", dem_world_dt_report(w));
     if (bad) exp_fail(err, len, "%s", dem_h5_error(h5));
     if (dem_h5_close(h5, bad ? NULL : err, bad ? 0 : len)) bad = 1;
     return bad;
 }
 
-int exp_result_write_json(const char *dir, exp_result_json_fn write, const void *ctx, char *err, size_t len)
+int exp_result_file_open(exp_result_file *a, const char *path, char *err, size_t len)
 {
-    char path[1100], tmp[1200];
-    snprintf(path, sizeof path, "%s/result.json", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s'", path);
-    write(f, ctx);
-    // A result.json is read by scripts as the run's outcome: on disk whole,
-    // or not replaced at all (a crash leaves the .tmp, never half a file).
-    int bad = ferror(f) | (fflush(f) != 0) | (fsync(fileno(f)) != 0);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        return exp_fail(err, len, "cannot write '%s'", path);
+    snprintf(a->path, sizeof a->path, "%s", path);
+    snprintf(a->tmp, sizeof a->tmp, "%s.tmp", path);
+    a->f = fopen(a->tmp, "w");
+    return a->f ? 0 : exp_fail(err, len, "cannot write '%s': %s", a->tmp, strerror(errno));
+}
+
+int exp_result_file_commit(exp_result_file *a, char *err, size_t len)
+{
+    // A run's files are read by scripts as its outcome: on disk whole, or not
+    // replaced at all (a crash leaves the .tmp, never half a file).
+    int bad = ferror(a->f) | (fflush(a->f) != 0) | (fsync(fileno(a->f)) != 0);
+    bad |= fclose(a->f) != 0;
+    a->f = NULL;
+    if (bad || rename(a->tmp, a->path) != 0) {
+        remove(a->tmp);
+        return exp_fail(err, len, "cannot write '%s'", a->path);
     }
     return 0;
+}
+
+void exp_result_file_abort(exp_result_file *a)
+{
+    if (a->f) fclose(a->f), a->f = NULL;
+    remove(a->tmp);
+}
+
+int exp_result_write_json(const char *dir, exp_result_json_fn write, const void *ctx, char *err, size_t len)
+{
+    char path[1100];
+    exp_result_file a;
+    snprintf(path, sizeof path, "%s/result.json", dir);
+    if (exp_result_file_open(&a, path, err, len)) return 1;
+    write(a.f, ctx);
+    return exp_result_file_commit(&a, err, len);
 }
 
 void exp_result_print_failure(const char *experiment, const char *err)

@@ -3,7 +3,6 @@
 // See exp_compress_runner.h.
 #include "exp_compress_runner.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,10 +14,9 @@
 int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
                              size_t len)
 {
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
+    exp_result_file a;
+    if (exp_result_file_open(&a, csv_path, err, len)) return 1;
+    FILE *f = a.f;
     // The engine's axial totals come last, so the columns before keep their places.
     fprintf(f, "t_s,cycle,loading,piston_y_m,displacement_m,strain,force_top_N,force_bottom_N,force_side_normal_N,"
                "sigma_Pa,ke_over_elastic,piston_axial_total_N,floor_axial_total_N,side_axial_total_N\n");
@@ -28,7 +26,7 @@ int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path,
                 s->piston_y, s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic,
                 s->f_piston_axial, s->f_floor_axial, s->f_side_axial);
     }
-    if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
+    if (exp_result_file_commit(&a, err, len)) return 1;
     if (!png_path) return 0;
     // One series per cycle, displacement in mm against the piston force.
     int nc = r->n_cycles > 0 ? r->n_cycles : 1;

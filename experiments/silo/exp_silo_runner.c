@@ -3,7 +3,6 @@
 // See exp_silo_runner.h.
 #include "exp_silo_runner.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,10 +15,9 @@
 int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp_silo_def *d, size_t plate_spheres,
                                  char *err, size_t len)
 {
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
+    exp_result_file a;
+    if (exp_result_file_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
     dem_granules_view g = dem_world_granules(w);
     double r = d->silo_radius;
     fprintf(f, "LIGGGHTS data file: silo discharge at t = 0 (granucal exp_silo; type 1 flowing, 2 plate)\n\n");
@@ -32,23 +30,22 @@ int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp
         fprintf(f, "%llu %d %.17g %.17g %.17g %.17g %.17g\n", (unsigned long long)g.id[i] + 1, plate ? 2 : 1,
                 2 * g.radius[i], d->density, g.position[i].x, g.position[i].y, g.position[i].z);
     }
-    if (fclose(f) != 0 || rename(tmp, path) != 0) return exp_fail(err, len, "cannot write '%s'", path);
+    if (exp_result_file_commit(&a, err, len)) return 1;
     return 0;
 }
 
 int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const char *png_prefix, char *err, size_t len)
 {
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return exp_fail(err, len, "cannot write '%s': %s", tmp, strerror(errno));
+    exp_result_file a;
+    if (exp_result_file_open(&a, csv_path, err, len)) return 1;
+    FILE *f = a.f;
     fprintf(f, "t_s,contacts,wall_contacts,ke_translational_J,ke_rotational_J,ke_total_J,discharged,discharged_mass_kg\n");
     for (size_t k = 0; k < r->n_series; ++k) {
         const exp_silo_sample *s = &r->series[k];
         fprintf(f, "%.4f,%zu,%zu,%.6g,%.6g,%.6g,%zu,%.6g\n", s->t, s->contacts, s->wall_contacts, s->ke_translational,
                 s->ke_rotational, s->ke_translational + s->ke_rotational, s->discharged, s->discharged_mass);
     }
-    if (fclose(f) != 0 || rename(tmp, csv_path) != 0) return exp_fail(err, len, "cannot write '%s'", csv_path);
+    if (exp_result_file_commit(&a, err, len)) return 1;
     if (!png_prefix) return 0;
     size_t n = r->n_series;
     double *t = malloc((n + 1) * sizeof *t), *c = malloc((n + 1) * sizeof *c), *ke = malloc((n + 1) * sizeof *ke);
