@@ -26,6 +26,10 @@ typedef struct exp_cylinder_def {
 
 exp_cylinder_def exp_default_cylinder_def(void);
 
+/// Every field of a definition exp_cylinder_run would pour, or 1 with a
+/// message that starts with the field ("lambda = ...", "granule_contact.mu_s = ...").
+int exp_cylinder_check(const exp_cylinder_def *d, char *msg, size_t len);
+
 /// Coordination numbers of a poured bed at rest: the cylinder's, or the
 /// drum's own bed (exp_drum_bed.h), counted by one rule (exp_count_bed_contacts).
 typedef struct exp_cylinder_result {

@@ -4,13 +4,9 @@
 #include "exp_cylinder_config.h"
 
 #include <cyaml/cyaml.h>
-#include <errno.h>
-#include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "dem_scaling.h"
 #include "exp_contact_rules.h"
 #include "exp_yaml.h"
 
@@ -35,27 +31,6 @@ static const cyaml_schema_value_t cylinder_schema = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cylinder_yaml, cylinder_fields)};
 
 int exp_is_cylinder_config(const char *path) { return exp_yaml_starts_with(path, "experiment: cylinder"); }
-
-int exp_cylinder_check(const exp_cylinder_def *d, char *msg, size_t len)
-{
-    char sub[256];
-    if (!(isfinite(d->diameter) && d->diameter > 0)) return exp_fail(msg, len, "diameter = %g: must be > 0", d->diameter);
-    if (!(isfinite(d->depth) && d->depth > 0)) return exp_fail(msg, len, "depth = %g: must be > 0", d->depth);
-    if (!(isfinite(d->density) && d->density > 0)) return exp_fail(msg, len, "density = %g: must be > 0", d->density);
-    if (!(isfinite(d->lambda) && d->lambda >= 1) || dem_scale_check(d->lambda, sub, sizeof sub))
-        return exp_fail(msg, len, "lambda = %g: must be finite and >= 1 (lambda = N_real/N_scaled, eq. 15)", d->lambda);
-    if (dem_gsd_check(&d->gsd, sub, sizeof sub)) return exp_fail(msg, len, "%s", sub);
-    if (dem_contact_params_check(&d->granule, sub, sizeof sub)) return exp_fail(msg, len, "granule_contact.%s", sub);
-    if (dem_contact_params_check(&d->wall, sub, sizeof sub)) return exp_fail(msg, len, "wall_contact.%s", sub);
-    // The pour's lattice pitch is 1.05 d_max and keeps 0.55 pitch off the wall
-    // (exp_pour_to_rim): the container must hold a lattice point and a granule.
-    double dmax = dem_gsd_max_diameter(&d->gsd) * cbrt(d->lambda);
-    if (d->diameter < 2.2 * dmax || d->depth < dmax)
-        return exp_fail(msg, len,
-                        "lambda = %g: the largest scaled granule (%.3g m) does not fit the %.3g x %.3g m container",
-                        d->lambda, dmax, d->diameter, d->depth);
-    return 0;
-}
 
 static int to_def(const cylinder_yaml *y, exp_cylinder_def *d, char *err, size_t len)
 {

@@ -13,10 +13,6 @@
 /// 1 if the file is a poured-cylinder config (its first key is `experiment: cylinder`).
 int exp_is_cylinder_config(const char *path);
 
-/// Every field of a definition exp_cylinder_run would pour, or 1 with a
-/// message that starts with the field ("lambda = ...", "granule_contact.mu_s = ...").
-int exp_cylinder_check(const exp_cylinder_def *d, char *msg, size_t len);
-
 /// Load `path`, apply `--set` overrides ("key=value": k_n, mu_s, mu_r, xi,
 /// lambda, seed, diameter, depth, density) and validate. 0, or 1 with a
 /// message naming the file, line and field ("FILE:LINE: FIELD: problem"), or
