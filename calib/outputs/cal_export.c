@@ -453,38 +453,37 @@ static const char lattice_pass[] =
     "group new delete\n"
     "region sites delete\nregion above_bed delete\n";
 
-static int write_liggghts_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
+// What one code's deck says its own way; the rest of a deck is the same text
+// in both (write_deck).
+typedef struct deck_code {
+    const char *name;                    ///< deck_path's: "liggghts", "lammps"
+    const char *title, *exe, *deck_file, *params_file, *dump_file;
+    void (*before_variables)(FILE *f, const deck_scene *s); ///< may be NULL
+    /// From the atom style to the still drum: box, parameters, step, gravity.
+    void (*setup)(FILE *f, const cal_outcome *o, const deck_scene *s);
+    void (*turn)(FILE *f, const deck_scene *s); ///< the drum set turning
+} deck_code;
+
+static void liggghts_before_variables(FILE *f, const deck_scene *s)
 {
-    char path[1200];
-    deck_path(path, sizeof path, dir, "liggghts");
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
-    FILE *f = a.f;
-    deck_title(f, o, "LIGGGHTS 3.8", "liggghts", "liggghts_drum.in", "liggghts_parameters.in");
-    deck_scene_text(f, o, s);
-    deck_step_text(f, s);
-    deck_steps_text(f, lattice_pour_text);
     if (!s->drum.periodic)
         fputs("# LIGGGHTS' primitive planes cannot turn: the end plates stand still while the drum turns (granucal "
               "turns\n# them with it).\n", f);
-    deck_variables(f, o, s, "liggghts_drum.dump");
+}
+
+static void liggghts_setup(FILE *f, const cal_outcome *o, const deck_scene *s)
+{
     fputs("variable wall_type equal v_lining+1\n\natom_style granular\natom_modify map array\ncommunicate single vel yes\n", f);
     deck_box(f, s, 1 + o->table.n_walls);
     fputs("include liggghts_parameters.in\ntimestep ${dt}\nfix gravi all gravity 9.81 vector 0. -1. 0.\n", f);
     liggghts_walls(f, s, "");
-    fputs("fix integr all nve/sphere\n", f);
-    lattice_pour(f, s);
-    deck_thermo(f);
-    deck_pass_begin(f);
-    fputs(lattice_pass, f);
-    deck_pass_end(f, "", "+v_pitch"); // a lattice site a pitch above every centre overlaps none
-    deck_cut_and_dump(f);
+}
+
+static void liggghts_turn(FILE *f, const deck_scene *s)
+{
     fputs("\n# The turn: in LIGGGHTS 3.8 a zcylinder's `shear x W` turns it about its axis at W rad/s, counter-clockwise\n"
           "# seen from +z (`shear z` would slide it along the axis).\nunfix drum\n", f);
     liggghts_walls(f, s, "shear x ${omega}");
-    fputs("run $(floor(v_spinup/v_dt+0.5))\ndump turn all custom ${every} ${dump} id type x y z vx vy vz radius\n"
-          "run $(floor(v_measure/v_dt+0.5))\n", f);
-    return cal_atomic_commit(&a, err, len);
 }
 
 // The drum: a cylinder region (a full drum's closed at its ends), turning
@@ -496,18 +495,8 @@ static void lammps_walls(FILE *f, const deck_scene *s, const char *name, const c
     fprintf(f, "fix drum all wall/gran/region granular ${wall_contact} region %s\n", name);
 }
 
-static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_scene *s, char *err, size_t len)
+static void lammps_setup(FILE *f, const cal_outcome *o, const deck_scene *s)
 {
-    char path[1200];
-    deck_path(path, sizeof path, dir, "lammps");
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
-    FILE *f = a.f;
-    deck_title(f, o, "LAMMPS (pair_style granular)", "lmp", "lammps_drum.in", "lammps_parameters.in");
-    deck_scene_text(f, o, s);
-    deck_step_text(f, s);
-    deck_steps_text(f, lattice_pour_text);
-    deck_variables(f, o, s, "lammps_drum.dump");
     fputs("\natom_style sphere\natom_modify map array\ncomm_modify vel yes\n", f);
     deck_box(f, s, 1);
     fputs("include lammps_parameters.in\n", f);
@@ -518,6 +507,37 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     }
     fputs("timestep ${dt}\nfix gravi all gravity 9.81 vector 0. -1. 0.\n", f);
     lammps_walls(f, s, "still", "");
+}
+
+static void lammps_turn(FILE *f, const deck_scene *s)
+{
+    fputs("\n# The turn: the region turns about z at omega rad/s (the wall takes its surface velocity from it).\n"
+          "unfix drum\nvariable theta equal v_omega*(time-$(time))\n", f);
+    lammps_walls(f, s, "turning", "rotate v_theta 0. 0. 0. 0. 0. 1. ");
+}
+
+static const deck_code liggghts_deck = {"liggghts", "LIGGGHTS 3.8", "liggghts", "liggghts_drum.in",
+                                        "liggghts_parameters.in", "liggghts_drum.dump", liggghts_before_variables,
+                                        liggghts_setup, liggghts_turn};
+static const deck_code lammps_deck = {"lammps", "LAMMPS (pair_style granular)", "lmp", "lammps_drum.in",
+                                      "lammps_parameters.in", "lammps_drum.dump", NULL, lammps_setup, lammps_turn};
+
+// One code's complete deck: the same pour, cut, dumps and runs in both.
+static int write_deck(const char *dir, const cal_outcome *o, const deck_scene *s, const deck_code *c, char *err,
+                      size_t len)
+{
+    char path[1200];
+    deck_path(path, sizeof path, dir, c->name);
+    cal_atomic_file a;
+    if (cal_atomic_open(&a, path, err, len)) return 1;
+    FILE *f = a.f;
+    deck_title(f, o, c->title, c->exe, c->deck_file, c->params_file);
+    deck_scene_text(f, o, s);
+    deck_step_text(f, s);
+    deck_steps_text(f, lattice_pour_text);
+    if (c->before_variables) c->before_variables(f, s);
+    deck_variables(f, o, s, c->dump_file);
+    c->setup(f, o, s);
     fputs("fix integr all nve/sphere\n", f);
     lattice_pour(f, s);
     deck_thermo(f);
@@ -525,9 +545,7 @@ static int write_lammps_deck(const char *dir, const cal_outcome *o, const deck_s
     fputs(lattice_pass, f);
     deck_pass_end(f, "", "+v_pitch"); // a lattice site a pitch above every centre overlaps none
     deck_cut_and_dump(f);
-    fputs("\n# The turn: the region turns about z at omega rad/s (the wall takes its surface velocity from it).\n"
-          "unfix drum\nvariable theta equal v_omega*(time-$(time))\n", f);
-    lammps_walls(f, s, "turning", "rotate v_theta 0. 0. 0. 0. 0. 1. ");
+    c->turn(f, s);
     fputs("run $(floor(v_spinup/v_dt+0.5))\ndump turn all custom ${every} ${dump} id type x y z vx vy vz radius\n"
           "run $(floor(v_measure/v_dt+0.5))\n", f);
     return cal_atomic_commit(&a, err, len);
@@ -544,8 +562,8 @@ static int write_decks(const char *dir, const cal_outcome *o, char *err, size_t 
         return 0;
     }
     deck_scene s;
-    return scene_of(o, &s, err, len) || write_liggghts_deck(dir, o, &s, err, len) ||
-           write_lammps_deck(dir, o, &s, err, len);
+    return scene_of(o, &s, err, len) || write_deck(dir, o, &s, &liggghts_deck, err, len) ||
+           write_deck(dir, o, &s, &lammps_deck, err, len);
 }
 
 int cal_export_write(const char *dir, const cal_outcome *o, char *err, size_t len)
