@@ -11,6 +11,7 @@
 
 #include <cyaml/cyaml.h>
 
+#include "cal_cli_frame.h"
 #include "cal_commands.h"
 #include "cal_files.h"
 #include "cal_mpi.h"
@@ -19,10 +20,6 @@
 #include "cal_report.h"
 #include "exp_common.h"
 #include "exp_yaml.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 static const char synopsis[] =
     "usage: granucal calibrate [CONFIG.yaml] [options]\n"
@@ -739,16 +736,8 @@ int cal_cmd_calibrate(int argc, char **argv)
     if (!r) return fputs("granucal calibrate: out of memory\n", stderr), 1;
     int status = parse_options(argc, argv, &r->opt);
     if (status) return free(r), status < 0 ? 0 : status;
-    char command[2048] = "granucal";
-    for (int k = 0; k < argc; ++k)
-        snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
-    cal_mpi_init(&argc, &argv);
-#ifdef _OPENMP
-    // Parallelism is across simulations (processes, ranks); each simulation
-    // runs on one thread, which also keeps forked children clear of the
-    // OpenMP runtime's threads.
-    omp_set_num_threads(1);
-#endif
+    char command[2048];
+    cal_cli_begin(&argc, &argv, command, sizeof command);
     status = prepare(r);
     if (!status && r->opt.plan_only) fputs("granucal calibrate: --plan: every input checked, nothing was run\n", stderr);
     else if (!status) {
@@ -757,14 +746,10 @@ int cal_cmd_calibrate(int argc, char **argv)
         r->env.checkpoint_every_s = r->opt.checkpoint_every_s;
         status = calibrate(r, command);
     }
-    if (status) fprintf(stderr, "granucal calibrate: %s\n", r->err);
-    status = cal_mpi_any(status);
-    cal_sim_release(&r->env); // the bed kept between candidates
+    status = cal_cli_end("calibrate", status, r->err, &r->env, r->c);
     cal_series_free(&r->angles), cal_series_free(&r->areas);
     free(r->granule);
     for (int w = 0; w < r->n_walls; ++w) free(r->walls[w]);
-    if (r->c) cal_config_free(r->c);
     free(r);
-    cal_mpi_finalize();
-    return status ? 1 : 0;
+    return status;
 }

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cal_case_runs.h"
+#include "cal_cli_frame.h"
 #include "cal_commands.h"
 #include "cal_files.h"
 #include "cal_mpi.h"
@@ -19,10 +20,6 @@
 #include "cal_plan.h"
 #include "exp_common.h"
 #include "exp_plot.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 static const char synopsis[] =
     "usage: granucal study fidelity [CONFIG.yaml] [options]\n"
@@ -720,12 +717,8 @@ int cal_cmd_study(int argc, char **argv)
     // `study --help` is the fidelity study's: the one study there is.
     int status = asks_help ? parse_options(argc, argv, &s->opt) : parse_options(argc - 1, argv + 1, &s->opt);
     if (status) return free(s), status < 0 ? 0 : status;
-    char command[2048] = "granucal";
-    for (int k = 0; k < argc; ++k) snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
-    cal_mpi_init(&argc, &argv);
-#ifdef _OPENMP
-    omp_set_num_threads(1); // parallel across simulations, one thread each (as calibrate)
-#endif
+    char command[2048];
+    cal_cli_begin(&argc, &argv, command, sizeof command);
     double t0 = exp_wall_seconds();
     s->c = cal_config_load(s->opt.config, NULL, s->err, sizeof s->err);
     if (s->c && !s->c->fidelity) status = exp_fail(s->err, sizeof s->err, "%s: has no `fidelity:` section", s->c->path);
@@ -762,11 +755,7 @@ int cal_cmd_study(int argc, char **argv)
                  write_plots(s, s->err, sizeof s->err);
         if (!status) fprintf(stderr, "granucal study: wrote %s/fidelity.md and its CSV and plots\n", s->report);
     }
-    if (status) fprintf(stderr, "granucal study: %s\n", s->err);
-    status = cal_mpi_any(status);
-    cal_sim_release(&s->env);
-    if (s->c) cal_config_free(s->c);
+    status = cal_cli_end("study", status, s->err, &s->env, s->c);
     free(s);
-    cal_mpi_finalize();
-    return status ? 1 : 0;
+    return status;
 }

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "cal_case_runs.h"
+#include "cal_cli_frame.h"
 #include "cal_commands.h"
 #include "cal_data.h"
 #include "cal_files.h"
@@ -25,10 +26,6 @@
 #include "cal_stages.h"
 #include "cal_store.h"
 #include "exp_common.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 enum { MAX_SEEDS = 16, MAX_WALLS = 16 };
 
@@ -400,12 +397,8 @@ int cal_cmd_synthesize(int argc, char **argv)
     if (!j) return fputs("granucal synthesize: out of memory\n", stderr), 1;
     int status = parse_options(argc, argv, &j->opt);
     if (status) return free(j), status < 0 ? 0 : status;
-    char command[2048] = "granucal";
-    for (int k = 0; k < argc; ++k) snprintf(command + strlen(command), sizeof command - strlen(command), " %s", argv[k]);
-    cal_mpi_init(&argc, &argv);
-#ifdef _OPENMP
-    omp_set_num_threads(1); // parallel across simulations, one thread each (as calibrate)
-#endif
+    char command[2048];
+    cal_cli_begin(&argc, &argv, command, sizeof command);
     lining_result res[MAX_WALLS + 1];
     status = prepare(j);
     if (!status && j->opt.plan_only) {
@@ -420,11 +413,7 @@ int cal_cmd_synthesize(int argc, char **argv)
         status = write_files(j, res, command);
         if (!status) fprintf(stderr, "granucal synthesize: wrote %s/repose_angle.csv and occupied_area.csv\n", j->out);
     }
-    if (status) fprintf(stderr, "granucal synthesize: %s\n", j->err);
-    status = cal_mpi_any(status);
-    cal_sim_release(&j->env);
-    if (j->c) cal_config_free(j->c);
+    status = cal_cli_end("synthesize", status, j->err, &j->env, j->c);
     free(j);
-    cal_mpi_finalize();
-    return status ? 1 : 0;
+    return status;
 }
