@@ -24,6 +24,7 @@
 
 #include <cmocka.h>
 
+#include "config_variant.h"
 #include "dem_scaling.h"
 #include "exp_compress.h"
 #include "exp_compress_config.h"
@@ -143,19 +144,10 @@ static void test_cycles_against_independent_estimates(void **state)
 static void test_bad_input_is_named(void **state)
 {
     (void)state;
-    char path[1024], tmp[] = "/tmp/granucal_compress_XXXXXX", err[1024], line[512];
+    char path[1024], tmp[] = "/tmp/granucal_compress_XXXXXX", err[1024];
     shipped_config(path, sizeof path);
-    int fd = mkstemp(tmp);
-    assert_true(fd >= 0);
-    FILE *in = fopen(path, "r"), *out = fdopen(fd, "w");
-    assert_non_null(in);
-    int n = 0, bad_line = 0;
-    while (fgets(line, sizeof line, in)) {
-        ++n;
-        if (strncmp(line, "sigma_max:", 10) == 0) strcpy(line, "sigma_max: 5\n"), bad_line = n;
-        fputs(line, out);
-    }
-    fclose(in), fclose(out);
+    int bad_line = config_variant(path, "sigma_max:", "sigma_max: 5", tmp);
+    assert_true(bad_line > 0);
     exp_compress_def d;
     assert_int_not_equal(exp_compress_load(tmp, 0, NULL, &d, err, sizeof err), 0);
     char want[64];

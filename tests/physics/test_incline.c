@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "exp_incline.h"
+#include "config_variant.h"
 #include "exp_incline_config.h"
 
 static void shipped_config(char *path, size_t len)
@@ -109,19 +110,10 @@ static void test_roll_slide_boundary(void **state)
 static void test_bad_input_is_named(void **state)
 {
     (void)state;
-    char path[1024], tmp[] = "/tmp/granucal_incline_XXXXXX", err[1024], line[512];
+    char path[1024], tmp[] = "/tmp/granucal_incline_XXXXXX", err[1024];
     shipped_config(path, sizeof path);
-    int fd = mkstemp(tmp);
-    assert_true(fd >= 0);
-    FILE *in = fopen(path, "r"), *out = fdopen(fd, "w");
-    assert_non_null(in);
-    int n = 0, bad_line = 0;
-    while (fgets(line, sizeof line, in)) {
-        ++n;
-        if (strncmp(line, "mu_s:", 5) == 0) strcpy(line, "mu_s: -1\n"), bad_line = n;
-        fputs(line, out);
-    }
-    fclose(in), fclose(out);
+    int bad_line = config_variant(path, "mu_s:", "mu_s: -1", tmp);
+    assert_true(bad_line > 0);
     exp_incline_def d;
     assert_int_not_equal(exp_incline_load(tmp, 0, NULL, &d, err, sizeof err), 0);
     char want[64];
