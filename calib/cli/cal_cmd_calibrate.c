@@ -18,6 +18,7 @@
 #include "cal_options.h"
 #include "cal_plan.h"
 #include "cal_report.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_yaml.h"
 
@@ -157,8 +158,8 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     fprintf(a.f, "# written by granucal calibrate; read by later stages run alone\nk_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
             k_n, mu_s, mu_r);
     if (ranges && isfinite(ranges[1].lo))
@@ -167,7 +168,7 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
                      "mu_r_not_excluded_min: %.17g\nmu_r_not_excluded_max: %.17g\n",
                 ranges[0].lo, ranges[0].hi, ranges[1].lo, ranges[1].hi, ranges[0].bracket_lo, ranges[0].bracket_hi,
                 ranges[1].bracket_lo, ranges[1].bracket_hi);
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // The identified ranges a stage file kept (NAN if none: μr's range is never 0).

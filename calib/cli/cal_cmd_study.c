@@ -18,6 +18,7 @@
 #include "cal_mpi.h"
 #include "cal_options.h"
 #include "cal_plan.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_plot.h"
 
@@ -336,9 +337,9 @@ static int write_csv(const study *s, char *err, size_t len)
 {
     const cal_fidelity *f = s->c->fidelity;
     char path[1200];
-    cal_atomic_file a;
+    exp_atomic_file a;
     snprintf(path, sizeof path, "%s/fidelity.csv", s->report);
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     fputs("rung,lambda,slice_depth_m,max_time_s,window_s,seeds,rpm,angle_deg,angle_sd_seeds_deg,angle_se_deg,csa_percent,"
           "csa_sd_seeds_percent,steady_runs,usable_runs\n",
           a.f);
@@ -350,9 +351,9 @@ static int write_csv(const study *s, char *err, size_t len)
                     r->rung->slice_depth, r->rung->max_time, r->rung->window, f->seeds, f->rpm[k], r->angle[k],
                     r->angle_sd[k], r->angle_se[k], r->csa[k], r->csa_sd[k], r->steady[k], r->usable[k]);
     }
-    if (cal_atomic_commit(&a, err, len)) return 1;
+    if (exp_atomic_commit(&a, err, len)) return 1;
     snprintf(path, sizeof path, "%s/fidelity_summary.csv", s->report);
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     fputs("rung,lambda,slice_depth_m,max_time_s,window_s,status,granules,particle_steps,wall_time_s,wall_time_per_run_s,"
           "predicted_wall_time_s,peak_rss_mb,dt_s,angle_error_deg,csa_rms_error_percent,finest_rung\n",
           a.f);
@@ -365,7 +366,7 @@ static int write_csv(const study *s, char *err, size_t len)
                 r->ran ? r->peak_rss_mb : NAN, r->ran ? r->dt_s : NAN, r->angle_error, r->csa_error,
                 s->finest >= 0 ? s->res[s->finest].rung->name : "");
     }
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 static void machine_line(FILE *f)
@@ -493,9 +494,9 @@ static int write_markdown(const study *s, const char *command, double wall, char
 {
     const cal_fidelity *f = s->c->fidelity;
     char path[1200];
-    cal_atomic_file a;
+    exp_atomic_file a;
     snprintf(path, sizeof path, "%s/fidelity.md", s->report);
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *o = a.f;
     fprintf(o, "# What accuracy costs in time: the drum fidelity ladder\n\nCommand: `%s`  \ngranucal %s (commit %s), "
                "config `%s`, %.0f s wall for this run (stored simulations are not rerun).  \n",
@@ -547,7 +548,7 @@ static int write_markdown(const study *s, const char *command, double wall, char
     fprintf(o, "\nFiles: `fidelity.csv` (every rung and speed), `fidelity_summary.csv`, `fidelity_error_vs_cost.png`, "
                "`%s`%s.\n",
             versus_file(s), f->rpm_count > 1 ? ", `fidelity_vs_rpm.png`" : "");
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // Each rung run, in the order of the ladder: what the two figures plot.

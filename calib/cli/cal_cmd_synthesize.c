@@ -25,6 +25,7 @@
 #include "cal_plan.h"
 #include "cal_stages.h"
 #include "cal_store.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 
 enum { MAX_SEEDS = 16, MAX_WALLS = 16 };
@@ -314,9 +315,9 @@ static void write_header(FILE *f, const job *j, const char *what, const char *co
 static int write_series(job *j, const lining_result *res, const char *command, int angle)
 {
     char path[1200];
-    cal_atomic_file a;
+    exp_atomic_file a;
     snprintf(path, sizeof path, "%s/%s", j->out, angle ? "repose_angle.csv" : "occupied_area.csv");
-    if (cal_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
+    if (exp_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
     write_header(a.f, j, angle ? "Dynamic angle of repose" : "Occupied cross-section area (eq. 20)", command);
     fputs(angle ? "surface,rpm,angle_deg,angle_sd_deg\n" : "surface,rpm,csa_percent,csa_sd_percent\n", a.f);
     for (int l = 0; l < j->n_linings; ++l)
@@ -325,7 +326,7 @@ static int write_series(job *j, const lining_result *res, const char *command, i
             summary v = angle ? res[l].angle[k] : res[l].csa[k];
             fprintf(a.f, "%s,%g,%.3f,%.3f\n", j->linings[l].surface, j->rpm[k], v.mean, spread_of(v));
         }
-    return cal_atomic_commit(&a, j->err, sizeof j->err);
+    return exp_atomic_commit(&a, j->err, sizeof j->err);
 }
 
 static int write_files(job *j, const lining_result *res, const char *command)

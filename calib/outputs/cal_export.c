@@ -13,6 +13,7 @@
 #include "dem_gsd.h"
 #include "dem_scaling.h"
 #include "dem_world.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_contact_rules.h"
 #include "exp_cost.h"
@@ -114,8 +115,8 @@ static int write_liggghts(const char *dir, const cal_outcome *o, char *err, size
     const cal_table *t = &o->table;
     char path[1200];
     snprintf(path, sizeof path, "%s/liggghts_parameters.in", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     int n = 1 + t->n_walls;
     fprintf(f, "# granucal %s: the table's parameters for LIGGGHTS 3.8.\n", exp_version());
@@ -133,7 +134,7 @@ static int write_liggghts(const char *dir, const cal_outcome *o, char *err, size
             for (int j = 0; j < n; ++j) liggghts_entry(f, o, p, i, j);
         fputc('\n', f);
     }
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // The granular keywords of one contact for LAMMPS, stiffness and damping
@@ -159,8 +160,8 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
     const cal_table *t = &o->table;
     char path[1200];
     snprintf(path, sizeof path, "%s/lammps_parameters.in", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     fprintf(f, "# granucal %s: the table's parameters for LAMMPS pair_style granular.\n", exp_version());
     write_status(f, o);
@@ -177,7 +178,7 @@ static int write_lammps(const char *dir, const cal_outcome *o, char *err, size_t
         lammps_keywords(f, o->config, exp_boundary_stiffness(t->k_n), t->wall_mu_s[w], t->wall_mu_r[w], 1);
         fputs("\"\n", f);
     }
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // ---------------------------------------------------------------------------
@@ -528,8 +529,8 @@ static int write_deck(const char *dir, const cal_outcome *o, const deck_scene *s
 {
     char path[1200];
     deck_path(path, sizeof path, dir, c->name);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     deck_title(f, o, c->title, c->exe, c->deck_file, c->params_file);
     deck_scene_text(f, o, s);
@@ -548,7 +549,7 @@ static int write_deck(const char *dir, const cal_outcome *o, const deck_scene *s
     c->turn(f, s);
     fputs("run $(floor(v_spinup/v_dt+0.5))\ndump turn all custom ${every} ${dump} id type x y z vx vy vz radius\n"
           "run $(floor(v_measure/v_dt+0.5))\n", f);
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // The decks need a wall material to line the drum with: without one (the

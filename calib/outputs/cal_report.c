@@ -13,6 +13,7 @@
 #include "cal_files.h"
 #include "cal_posterior.h"
 #include "cal_status.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_contact_rules.h"
 
@@ -68,8 +69,8 @@ static int write_table_csv(const char *dir, const cal_outcome *o, const posterio
 {
     char path[1200], data[64];
     snprintf(path, sizeof path, "%s/calibrated_parameters.csv", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     // identified_min/max: the range of the candidates the data cannot tell
     // apart (cal_friction_identify); not_excluded_min/max: its bracket, the
     // interval no evaluated candidate excludes (cal_range); empty where
@@ -97,7 +98,7 @@ static int write_table_csv(const char *dir, const cal_outcome *o, const posterio
         if (q) fprintf(a.f, "%.6g,%.6g,%.6g\n", q->median[p], q->lo[p], q->hi[p]);
         else fputs(",,\n", a.f);
     }
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // The range, and a warning when the chosen value lies outside it: the choice
@@ -173,8 +174,8 @@ static int write_table_md(const char *dir, const cal_outcome *o, const posterior
     const cal_table *t = &o->table;
     char path[1200];
     snprintf(path, sizeof path, "%s/calibrated_parameters.md", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     cal_run_status rs = cal_run_status_of(o);
     cal_run_status_banner(f, &rs, "> ");
@@ -195,7 +196,7 @@ static int write_table_md(const char *dir, const cal_outcome *o, const posterior
         md_row(&m, "", "Sliding friction μs,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_s"), t->wall_source[w]);
     for (int w = 0; w < t->n_walls; ++w)
         md_row(&m, "", "Rolling friction μr,g-s", find_row(rows, n, gw, t->wall_name[w], "mu_r"), t->wall_source[w]);
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 typedef struct h5_row {
@@ -247,7 +248,7 @@ static int write_table_h5(const char *dir, const cal_outcome *o, const cal_table
 {
     char path[1200], tmp[1300];
     snprintf(path, sizeof path, "%s/calibrated_parameters.h5", dir);
-    cal_temporary_name(path, tmp, sizeof tmp);
+    exp_temporary_name(path, tmp, sizeof tmp);
     h5_row *data = calloc((size_t)n, sizeof *data);
     if (!data) return exp_fail(err, len, "out of memory");
     h5_rows(rows, n, data);
@@ -357,8 +358,8 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/simulations.csv", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     fputs("stage,candidate,record,experiment,mu_s,mu_r,rpm_or_k_n,status,reason,angle_deg,angle_sd_deg,csa_percent,"
           "csa_sd_percent,steady,simulated_time_s,wall_time_s,fill_wall_time_s,particle_steps,granules,"
           "dt_s_or_coordination,peak_rss_mb\n",
@@ -381,7 +382,7 @@ static int write_simulations(const char *dir, const char *store, const cal_outco
         }
     if (o->granule) simulations_of(a.f, o, o->granule, store, tally);
     for (int w = 0; w < o->n_walls; ++w) simulations_of(a.f, o, o->walls[w], store, tally);
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 // ---- report -------------------------------------------------------------------------
@@ -595,8 +596,8 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/report.md", dir);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     const cal_tier *t = o->tier;
     cal_run_status rs = cal_run_status_of(o);
@@ -643,7 +644,7 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
         }
     report_cost(f, o, tally);
     cal_export_report(f, dir);
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 static int write_figures(const char *dir, const cal_outcome *o, const posteriors *post, char *err, size_t len)

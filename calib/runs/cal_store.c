@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cal_files.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_yaml.h"
 
@@ -40,7 +41,7 @@ static const char *this_run(void)
     static char id[128];
     if (!id[0]) {
         char host[64];
-        cal_host_name(host);
+        exp_host_name(host);
         snprintf(id, sizeof id, "%s:%ld", host, (long)getpid());
     }
     return id;
@@ -137,8 +138,8 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
 {
     char path[1200];
     cal_store_path(dir, r->key, path, sizeof path);
-    cal_atomic_file a;
-    if (cal_atomic_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     put_quoted(a.f, "key", r->key);
     put_quoted(a.f, "status", r->status);
     put_quoted(a.f, "reason", r->reason ? r->reason : "");
@@ -154,7 +155,7 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
             r->coordination_interior, r->wall_contacts_per_granule, r->solid_fraction, r->steady ? "true" : "false",
             r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->fill_wall_time_s, r->peak_rss_mb,
             isfinite(r->dt_margin_min) ? r->dt_margin_min : 0, r->dt_lowered, r->granules); // YAML 0, not nan: unchecked
-    return cal_atomic_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 void cal_record_free(cal_record *r)

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "dem_output.h"
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 
 dem_h5_writer *exp_result_h5_open(const char *dir, char *err, size_t len)
@@ -34,42 +35,14 @@ int exp_result_write_h5(const char *dir, const dem_world *w, char *err, size_t l
     return bad;
 }
 
-int exp_result_file_open(exp_result_file *a, const char *path, char *err, size_t len)
-{
-    snprintf(a->path, sizeof a->path, "%s", path);
-    snprintf(a->tmp, sizeof a->tmp, "%s.tmp", path);
-    a->f = fopen(a->tmp, "w");
-    return a->f ? 0 : exp_fail(err, len, "cannot write '%s': %s", a->tmp, strerror(errno));
-}
-
-int exp_result_file_commit(exp_result_file *a, char *err, size_t len)
-{
-    // A run's files are read by scripts as its outcome: on disk whole, or not
-    // replaced at all (a crash leaves the .tmp, never half a file).
-    int bad = ferror(a->f) | (fflush(a->f) != 0) | (fsync(fileno(a->f)) != 0);
-    bad |= fclose(a->f) != 0;
-    a->f = NULL;
-    if (bad || rename(a->tmp, a->path) != 0) {
-        remove(a->tmp);
-        return exp_fail(err, len, "cannot write '%s'", a->path);
-    }
-    return 0;
-}
-
-void exp_result_file_abort(exp_result_file *a)
-{
-    if (a->f) fclose(a->f), a->f = NULL;
-    remove(a->tmp);
-}
-
 int exp_result_write_json(const char *dir, exp_result_json_fn write, const void *ctx, char *err, size_t len)
 {
     char path[1100];
-    exp_result_file a;
+    exp_atomic_file a;
     snprintf(path, sizeof path, "%s/result.json", dir);
-    if (exp_result_file_open(&a, path, err, len)) return 1;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     write(a.f, ctx);
-    return exp_result_file_commit(&a, err, len);
+    return exp_atomic_commit(&a, err, len);
 }
 
 void exp_result_print_failure(const char *experiment, const char *err)

@@ -11,7 +11,7 @@
 ///    (a temporary file, flushed to disk, renamed).
 ///  - on stdout, the JSON of a run that failed before it had a result.
 /// And the way every other file of a run is written whole or not at all
-/// (curve.csv, series.csv, trajectory.csv, ...): exp_result_file.
+/// (curve.csv, series.csv, trajectory.csv, ...): exp_atomic_file.
 #ifndef EXP_RESULT_H
 #define EXP_RESULT_H
 
@@ -32,20 +32,6 @@ dem_h5_writer *exp_result_h5_open(const char *dir, char *err, size_t len);
 /// The world now as one frame with its diagnostics. 0, or non-zero (the
 /// writer's message: dem_h5_error).
 int exp_result_h5_frame(dem_h5_writer *h5, const dem_world *w);
-
-/// A file written whole or not at all: `f` writes PATH.tmp, which
-/// exp_result_file_commit flushes to disk and renames to PATH, and
-/// exp_result_file_abort removes.
-typedef struct exp_result_file {
-    FILE *f;
-    char path[1100], tmp[1200];
-} exp_result_file;
-
-/// 0, or 1 with a message naming the file.
-int exp_result_file_open(exp_result_file *a, const char *path, char *err, size_t len);
-/// Closes `f`; 0, or 1 with a message naming the file (the .tmp removed).
-int exp_result_file_commit(exp_result_file *a, char *err, size_t len);
-void exp_result_file_abort(exp_result_file *a);
 
 /// Formats an experiment's JSON summary on `f` (a file or stdout): the same
 /// function writes result.json and the copy on stdout, so the two agree.

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "exp_atomic_file.h"
 #include "exp_plot.h"
 #include "exp_result.h"
 
@@ -14,8 +15,8 @@
 int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path, const char *png_path, char *err,
                              size_t len)
 {
-    exp_result_file a;
-    if (exp_result_file_open(&a, csv_path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, csv_path, err, len)) return 1;
     FILE *f = a.f;
     // The engine's axial totals come last, so the columns before keep their places.
     fprintf(f, "t_s,cycle,loading,piston_y_m,displacement_m,strain,force_top_N,force_bottom_N,force_side_normal_N,"
@@ -26,7 +27,7 @@ int exp_compress_write_curve(const exp_compress_result *r, const char *csv_path,
                 s->piston_y, s->displacement, s->strain, s->f_top, s->f_bottom, s->f_side, s->sigma, s->ke_over_elastic,
                 s->f_piston_axial, s->f_floor_axial, s->f_side_axial);
     }
-    if (exp_result_file_commit(&a, err, len)) return 1;
+    if (exp_atomic_commit(&a, err, len)) return 1;
     if (!png_path) return 0;
     // One series per cycle, displacement in mm against the piston force.
     int nc = r->n_cycles > 0 ? r->n_cycles : 1;

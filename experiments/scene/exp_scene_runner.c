@@ -6,11 +6,12 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "exp_atomic_file.h"
 #include "exp_common.h"
 #include "exp_result.h"
 
 typedef struct sim_outputs {
-    exp_result_file csv;
+    exp_atomic_file csv;
     dem_h5_writer *h5;
 } sim_outputs;
 
@@ -35,11 +36,11 @@ static int open_outputs(sim_outputs *o, const char *dir, char *err, size_t len)
     char path[1100];
     if (exp_mkdirs(dir, err, len)) return 1;
     snprintf(path, sizeof path, "%s/trajectory.csv", dir);
-    if (exp_result_file_open(&o->csv, path, err, len)) return 1;
+    if (exp_atomic_open(&o->csv, path, err, len)) return 1;
     fprintf(o->csv.f, "t,id,x,y,z,vx,vy,vz,wx,wy,wz\n");
     o->h5 = exp_result_h5_open(dir, err, len);
     if (!o->h5) {
-        exp_result_file_abort(&o->csv);
+        exp_atomic_abort(&o->csv);
         return 1;
     }
     return 0;
@@ -98,7 +99,7 @@ static void summary_json(FILE *f, const void *ctx)
 static int finish(const char *dir, sim_outputs *o, const scene_report *r)
 {
     char err[1024];
-    int bad = exp_result_file_commit(&o->csv, err, sizeof err);
+    int bad = exp_atomic_commit(&o->csv, err, sizeof err);
     bad = bad || dem_h5_close(o->h5, err, sizeof err);
     if (!bad) bad = exp_result_write_json(dir, summary_json, r, err, sizeof err);
     if (bad) fprintf(stderr, "granucal simulate: %s\n", err);

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "exp_atomic_file.h"
 #include "exp_plot.h"
 #include "exp_result.h"
 
@@ -15,8 +16,8 @@
 int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp_silo_def *d, size_t plate_spheres,
                                  char *err, size_t len)
 {
-    exp_result_file a;
-    if (exp_result_file_open(&a, path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, path, err, len)) return 1;
     FILE *f = a.f;
     dem_granules_view g = dem_world_granules(w);
     double r = d->silo_radius;
@@ -30,14 +31,14 @@ int exp_silo_write_liggghts_data(const char *path, const dem_world *w, const exp
         fprintf(f, "%llu %d %.17g %.17g %.17g %.17g %.17g\n", (unsigned long long)g.id[i] + 1, plate ? 2 : 1,
                 2 * g.radius[i], d->density, g.position[i].x, g.position[i].y, g.position[i].z);
     }
-    if (exp_result_file_commit(&a, err, len)) return 1;
+    if (exp_atomic_commit(&a, err, len)) return 1;
     return 0;
 }
 
 int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const char *png_prefix, char *err, size_t len)
 {
-    exp_result_file a;
-    if (exp_result_file_open(&a, csv_path, err, len)) return 1;
+    exp_atomic_file a;
+    if (exp_atomic_open(&a, csv_path, err, len)) return 1;
     FILE *f = a.f;
     fprintf(f, "t_s,contacts,wall_contacts,ke_translational_J,ke_rotational_J,ke_total_J,discharged,discharged_mass_kg\n");
     for (size_t k = 0; k < r->n_series; ++k) {
@@ -45,7 +46,7 @@ int exp_silo_write_series(const exp_silo_result *r, const char *csv_path, const 
         fprintf(f, "%.4f,%zu,%zu,%.6g,%.6g,%.6g,%zu,%.6g\n", s->t, s->contacts, s->wall_contacts, s->ke_translational,
                 s->ke_rotational, s->ke_translational + s->ke_rotational, s->discharged, s->discharged_mass);
     }
-    if (exp_result_file_commit(&a, err, len)) return 1;
+    if (exp_atomic_commit(&a, err, len)) return 1;
     if (!png_prefix) return 0;
     size_t n = r->n_series;
     double *t = malloc((n + 1) * sizeof *t), *c = malloc((n + 1) * sizeof *c), *ke = malloc((n + 1) * sizeof *ke);

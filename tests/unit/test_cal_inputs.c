@@ -21,6 +21,7 @@
 #include "cal_files.h"
 #include "cal_stages.h"
 #include "cal_store.h"
+#include "exp_atomic_file.h"
 #include "exp_drum_config.h"
 #include "exp_scene.h"
 
@@ -462,7 +463,7 @@ static void test_sweep_removes_only_dead_writers_temporaries(void **state)
     snprintf(record, sizeof record, "%s/d.yaml", dir);
     const char *all[] = {dead, live, foreign, record};
     for (int i = 0; i < 4; i++) write_file(all[i], "x\n");
-    assert_int_equal(cal_atomic_sweep(dir), 1);
+    assert_int_equal(exp_atomic_sweep(dir), 1);
     assert_false(file_exists(dead));
     assert_true(file_exists(live) && file_exists(foreign) && file_exists(record));
     for (int i = 1; i < 4; i++) unlink(all[i]);
