@@ -51,6 +51,7 @@ int exp_silo_check(const exp_silo_def *d, char *msg, size_t len)
     if (!(d->duration > 0)) return exp_fail(msg, len, "duration = %g: must be > 0", d->duration);
     if (!(d->sample_interval >= d->dt)) return exp_fail(msg, len, "sample_interval = %g: must be >= dt", d->sample_interval);
     if (!(d->fill_xi >= 0 && d->fill_xi <= 1)) return exp_fail(msg, len, "fill_xi = %g: must be in [0, 1]", d->fill_xi);
+    if (!(d->fill_max_time > 0)) return exp_fail(msg, len, "fill_max_time = %g: must be > 0", d->fill_max_time);
     return 0;
 }
 

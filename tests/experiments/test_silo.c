@@ -5,7 +5,8 @@
 // kinetic + gravitational + elastic energy must be conserved through the
 // discharge (velocity Verlet at Δt = 1e-3 s ≈ 0.02 Δt_crit); the fixed plate
 // spheres do no work. With Table A.2's friction on, energy can only be lost.
-// Also: the scene switches on only what it uses (no damping, no rolling).
+// Also: the scene switches on only what it uses (no damping, no rolling),
+// and a bad key of configs/silo.yaml is refused with its file and line.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,7 +17,9 @@
 
 #include <cmocka.h>
 
+#include "config_variant.h"
 #include "exp_silo.h"
+#include "exp_silo_config.h"
 
 // Kinetic + gravitational (z up, g = 9.81) + elastic energy of the scene; the
 // fixed spheres (ids below n_fixed) neither move nor count.
@@ -74,8 +77,33 @@ static void test_energy_of_the_discharge(void **state)
     assert_non_null(strstr(effects, "granule-granule: damping off (approaching), tangential on, rolling off"));
 }
 
+// A bad value in configs/silo.yaml: refused with the file, the line and the key.
+static void refused_at_its_line(const char *key, const char *line)
+{
+    const char *src = getenv("GRANUCAL_SOURCE_DIR");
+    char path[1024], tmp[] = "/tmp/granucal_silo_XXXXXX", err[1024], want[128];
+    snprintf(path, sizeof path, "%s/configs/silo.yaml", src ? src : ".");
+    int bad_line = config_variant(path, key, line, tmp);
+    assert_true(bad_line > 0);
+    exp_silo_def d;
+    assert_int_not_equal(exp_silo_load(tmp, 0, NULL, &d, err, sizeof err), 0);
+    printf("%s\n", err);
+    snprintf(want, sizeof want, "%s:%d: %.*s", tmp, bad_line, (int)strcspn(key, ":"), key);
+    assert_non_null(strstr(err, want));
+    remove(tmp);
+}
+
+static void test_bad_input_is_named(void **state)
+{
+    (void)state;
+    refused_at_its_line("seed:", "seed: -1"); // a uint64_t seed would wrap
+    refused_at_its_line("fill_max_time:", "fill_max_time: 0");
+    refused_at_its_line("wall_k_n:", "wall_k_n: -5");
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_energy_of_the_discharge)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_energy_of_the_discharge),
+                                       cmocka_unit_test(test_bad_input_is_named)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
