@@ -17,6 +17,10 @@
 //    after the steady test, which shows a drift the running mean smooths.
 //   With SERIES_CSV=FILE set, every sample is also written there (seconds turned, angle, CSA), so that a
 //   rule for the transient or the averaging can be tried on the series without turning the bed again.
+//   With PRE_TURN=MU_S,MU_R,SECONDS set, the copy is first turned SECONDS at RPM with another granule pair
+//   (its samples in SERIES_CSV.pre when SERIES_CSV is set), then turned as above from where it is, without
+//   the start tilt: a candidate started from another candidate's turned bed instead of a level one (issue
+//   37.1's "start from a turned bed"). Such a run is not the record's; the line "this run" says so.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,6 +69,28 @@ static void mean_over(const series *s, int from, int to, double *angle, double *
     *angle = a / (to - from), *csa = c / (to - from);
 }
 
+// PRE_TURN's "MU_S,MU_R,SECONDS": `w` turned SECONDS at `rpm` with that granule pair (every sample in
+// `pre`), and the measured run set to go on from there without its start tilt. 0, or 1 with a message.
+static int pre_turn_bed(dem_world *w, const cal_config *c, const cal_tier *t, double k_n, int bed, double rpm,
+                        const char *spec, series *pre, exp_drum_run_opts *measured)
+{
+    double mu_s, mu_r, seconds;
+    if (sscanf(spec, "%lf,%lf,%lf", &mu_s, &mu_r, &seconds) != 3 || !(seconds > 0))
+        return fprintf(stderr, "PRE_TURN=%s: want MU_S,MU_R,SECONDS\n", spec), 1;
+    cal_drum_case a = cal_drum_case_granule(c, t, k_n, mu_s, mu_r);
+    a.def.seed = a.fill.seed = (uint64_t)(c->seed + bed);
+    exp_drum_run_opts o = cal_drum_run_opts(&a, rpm);
+    o.max_time = o.window = seconds; // every sample of the pre-turn kept, none averaged
+    o.steady_rule = EXP_STEADY_WINDOWS;
+    o.on_sample = keep, o.sample_ctx = pre;
+    exp_drum_result r;
+    if (exp_drum_rotate(w, &a.def, &o, NULL, NULL, &r) != DEM_OK) return fprintf(stderr, "the pre-turn failed\n"), 1;
+    printf("pre-turned %.2f s at mu_s %.17g, mu_r %.17g (ended at angle %.4f, CSA %.4f: its last sample)\n", seconds, mu_s,
+           mu_r, pre->n ? pre->m[pre->n - 1].angle_deg : NAN, pre->n ? pre->m[pre->n - 1].csa_percent : NAN);
+    measured->start_tilt_deg = 0; // the bed is already turned
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 10 && argc != 11)
@@ -95,6 +121,9 @@ int main(int argc, char **argv)
     // same bits as the bed itself, tests/physics/test_clone.c, and did here).
     dem_world *w = dem_world_clone(bed);
     if (!w) return fprintf(stderr, "out of memory\n"), 1;
+    series pre = {0};
+    const char *pre_turn = getenv("PRE_TURN");
+    if (pre_turn && pre_turn_bed(w, c, t, atof(argv[3]), atoi(argv[7]), rpm, pre_turn, &pre, &o)) return 1;
     exp_drum_result r;
     if (exp_drum_rotate(w, &d.def, &o, NULL, NULL, &r) != DEM_OK || !r.steady)
         return fprintf(stderr, "the run failed or was not steady\n"), 1;
@@ -105,8 +134,8 @@ int main(int argc, char **argv)
     const int same = rec.angle_deg == r.angle_deg && rec.csa_percent == r.csa_percent;
     printf("record: angle %.17g, CSA %.17g; this run: angle %.17g, CSA %.17g (%s the record); steady test held at "
            "%.2f s of turning\n",
-           rec.angle_deg, rec.csa_percent, r.angle_deg, r.csa_percent, same ? "reproduces" : "does NOT reproduce",
-           steady_at * o.sample_interval);
+           rec.angle_deg, rec.csa_percent, r.angle_deg, r.csa_percent,
+           pre_turn ? "pre-turned, so not" : same ? "reproduces" : "does NOT reproduce", steady_at * o.sample_interval);
     char *list = strdup(argv[9]), *save = NULL;
     for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         double T = atof(tok), angle, csa;
@@ -124,7 +153,13 @@ int main(int argc, char **argv)
                (b0 + block) * o.sample_interval, angle, csa);
     }
     const char *series_path = getenv("SERIES_CSV");
-    const int unwritten = series_path && write_series(series_path, &s, o.sample_interval);
+    int unwritten = series_path && write_series(series_path, &s, o.sample_interval);
+    if (series_path && pre_turn) {
+        char pre_path[1100];
+        snprintf(pre_path, sizeof pre_path, "%s.pre", series_path);
+        unwritten |= write_series(pre_path, &pre, o.sample_interval);
+    }
+    free(pre.m);
     free(list), free(s.m);
     cal_record_free(&rec);
     if (w != bed) dem_world_destroy(w);
