@@ -356,6 +356,8 @@ static void deck_variables(FILE *f, const cal_outcome *o, const deck_scene *s, c
     fprintf(f, "variable sample index %g          # s between dumped frames\n", sample);
     fprintf(f, "variable dt_fraction index %.4g    # of dt_crit (see above)\n", s->dt / s->dt_crit);
     fprintf(f, "variable pour_pass index %g        # s a pass of the pour falls before the next\n", DECK_POUR_PASS_S);
+    fputs("variable bed index 0               # which bed the pour makes: another whole number shifts its sizes and\n"
+          "                                   # velocities (several beds of one scene, as granucal's seeds give)\n", f);
     fprintf(f, "variable settle index %g           # s of settling after the pour and after the cut\n", DECK_SETTLE_S);
     fprintf(f, "variable dump index %s\n", dump);
     fprintf(f, "variable rdrum equal %.9g\nvariable depth equal %.9g\n", 0.5 * d->diameter, d->depth);
@@ -432,17 +434,20 @@ static void deck_pass_end(FILE *f, const char *after, const char *clearance)
 // 2021 and LIGGGHTS 3.8. LIGGGHTS' own pour (insert/pack, the classes at random
 // without overlap) made beds whose 40 rpm angle read 2.2 deg steeper over three
 // beds than granucal's; poured this way its angle agrees (results/peers/README.md).
+// `bed` shifts the sequence by 7919 (a prime) ids a bed: bed 0 is the sequence
+// of the atom id itself (id + 0 is id, bit for bit), another bed another pour.
 static void lattice_pour(FILE *f, const deck_scene *s)
 {
     fputs("\n# The pour, as granucal's: lattice sites one largest diameter apart above the bed, each granule with a small\n"
           "# sideways velocity (without it they land in columns), in passes.\n"
           "variable pitch equal 1.05*v_dmax\nlattice sc ${pitch} origin 0.5 0.5 0.5\n"
           "region inner cylinder z 0. 0. $(v_rdrum-0.55*v_pitch) $(0.5*v_pitch-1e-9) $(v_depth-0.5*v_pitch+1e-9) units box\n"
-          "variable u atom 0.6180339887498949*id-floor(0.6180339887498949*id)\n", f);
+          "variable n atom id+v_bed*7919\n"
+          "variable u atom 0.6180339887498949*v_n-floor(0.6180339887498949*v_n)\n", f);
     fprintf(f, "variable dnew atom (%.6g", s->bin_d[0]);
     double cum = 0;
     for (int k = 1; k < s->bins; ++k) cum += s->bin_p[k - 1], fprintf(f, "+(v_u>=%.6g)*%.6g", cum, s->bin_d[k] - s->bin_d[k - 1]);
-    fputs(")*v_cg\nvariable vx atom 0.05*sin(1.3*id)\nvariable vy atom -0.1+0*id\nvariable vz atom 0.05*cos(1.7*id)\n"
+    fputs(")*v_cg\nvariable vx atom 0.05*sin(1.3*v_n)\nvariable vy atom -0.1+0*id\nvariable vz atom 0.05*cos(1.7*v_n)\n"
           "variable floor string $(-v_rdrum)\n", f);
 }
 

@@ -108,7 +108,9 @@ BENCH=$OBJ/tests/bench_drum_peers
 # granucal's seed SD there and the ci tier's 40 rpm SD) of that peer's own smallest step, and so do
 # those of every smaller step: the step it can take without changing its own answer. The wall time per
 # simulated second then uses that step (the main run, same --out).
-TURN_FACTORS="0.1 0.1651 0.3 0.45 0.6"
+# TURN_FACTORS and PEERS (default both) may be set to scan fewer; PEER_BEDS="0 1 2" has each peer pour
+# several beds at each step (tests/peers/drum_peers.sh), so that one bed's noise does not decide its step.
+TURN_FACTORS=${TURN_FACTORS:-"0.1 0.1651 0.3 0.45 0.6"}
 turning_scan() {
   cmake --build "$OBJ" -j2 --target granucal drum_peers >/dev/null
   for f in $TURN_FACTORS; do
@@ -143,8 +145,8 @@ for code in ('liggghts', 'lammps'):
         if not broken: chosen = f
         if same: passing = f
         gd = num(r['angle_deg']) - num(g['angle_deg']) if g else float('nan')
-        print("  %-9s %.4g dt_crit: %6.2f deg, %6.2f %%; from its %.4g dt_crit run %+.2f deg %+.2f pts (tolerance %s, %s): %s;"
-              " from granucal %+.2f deg" % (code, f, num(r['angle_deg']), num(r['csa_pct']), f0, da, dc,
+        print("  %-9s %.4g dt_crit: %6.2f deg, %6.2f %% (beds %s); from its %.4g dt_crit run %+.2f deg %+.2f pts (tolerance %s, %s): %s;"
+              " from granucal %+.2f deg" % (code, f, num(r['angle_deg']), num(r['csa_pct']), r.get('beds') or '0', f0, da, dc,
                                              tol['angle_deg'], tol['csa_pct'], "same drum" if same else "NOT the same drum", gd))
     print("turning_step %s %.4g" % (code, chosen))
     # One bed per step: a step past the first that failed may pass on noise, or fail on it. Both said.

@@ -18,6 +18,10 @@
 #   measure 2.0  (s dumped; the deck's default is the tier's 4 s less its 1 s spinup)
 #   dt_fraction  only where DT_FRACTION is set (the deck's default: granucal's a-priori step;
 #                tests/bench/vs_peers.sh --turning-scan sets it to find the step each peer can take)
+#   bed          each of PEER_BEDS (default 0, the deck's own pour): with several (e.g. "0 1 2"), each
+#                peer pours and turns that many beds one after the other, and its angle and CSA are the
+#                mean over them with the spread between them as their sd (one bed's angle carries one
+#                pour's noise, which a time average of it cannot show: the turning scan's use)
 # The scene: the deck's drum (lambda, slice depth, fill, GSD as the deck says),
 # lined with its lining 1 (aluminium), 40 rpm.
 #  - granucal: `granucal simulate` of configs/drum.yaml at the deck's lambda and
@@ -90,19 +94,25 @@ grep -q "name: aluminium, mu_s: $wmus, mu_r: $wmur" drum.yaml || fail "drum.yaml
 sets=(--set lambda="$lambda" --set slice_depth="$depth" --set max_time=4.0 --set rpm=$RPM --set wall=aluminium
       --set mu_s="$gmus" --set mu_r="$gmur" --set k_n="$kn")
 
-# 3. The peers, side by side (one core each), while granucal waits.
-run_peer() { # CODE EXE DECK
-  rm -rf "$1" && mkdir "$1" && cp "$export_dir"/*.in "$1/"
+# 3. The peers, side by side (one core each), while granucal waits; a peer's beds one after the other.
+PEER_BEDS=${PEER_BEDS:-0}
+first_bed=${PEER_BEDS%% *}
+bed_dir() { [ "$2" = 0 ] && echo "$1" || echo "$1_bed$2"; } # CODE BED: bed 0 where a single run always was
+run_peer() { # CODE EXE DECK BED
+  local dir; dir=$(bed_dir "$1" "$4")
+  rm -rf "$dir" && mkdir "$dir" && cp "$export_dir"/*.in "$dir/"
   local step=()
   [ -n "${DT_FRACTION:-}" ] && step=(-var dt_fraction "$DT_FRACTION")
-  (cd "$1" && { time $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" "${step[@]}" -log $1.log > $1.out 2>&1; } 2> $1.time)
+  (cd "$dir" && { time $2 -in $3 -var rpm $RPM -var measure "$MEASURE_S" -var bed "$4" "${step[@]}" -log $1.log > $1.out 2>&1; } 2> $1.time) ||
+    { echo "$dir: $(tail -3 "$dir/$1.out")" >&2; return 1; }
 }
+run_beds() { for b in $PEER_BEDS; do run_peer "$1" "$2" "$3" "$b" || return 1; done; }
 declare -A pid
 for peer in $PEERS; do
-  run_peer $peer $(exe_of $peer) ${peer}_drum.in & pid[$peer]=$!
+  run_beds $peer $(exe_of $peer) ${peer}_drum.in & pid[$peer]=$!
 done
 for peer in $PEERS; do
-  wait ${pid[$peer]} || fail "${peer}_drum.in did not run: $(tail -3 $peer/$peer.out)"
+  wait ${pid[$peer]} || fail "${peer}_drum.in did not run (above)"
 done
 
 # 4. granucal, three seeds.
@@ -116,9 +126,21 @@ read -r g_angle g_angle_sd g_csa g_csa_sd < <(awk -F, '{a += $2; aa += $2 * $2; 
   END {printf "%.3f %.3f %.3f %.3f\n", a / n, sqrt((aa - a * a / n) / (n - 1)), c / n, sqrt((cc - c * c / n) / (n - 1))}' granucal.csv)
 
 # 5. Measure and compare.
+# A peer's beds measured one by one (BED.measure); with several, PEER.measure is their mean, its sd the
+# spread between the beds, its frames all of theirs.
 for peer in $PEERS; do
-  "$DP" measure drum.yaml $peer/${peer}_drum.dump "${sets[@]}" > $peer.measure
-  "$DP" measure drum.yaml $peer/bed.dump "${sets[@]}" > $peer.bed
+  for b in $PEER_BEDS; do
+    d=$(bed_dir $peer $b)
+    "$DP" measure drum.yaml $d/${peer}_drum.dump "${sets[@]}" > $d.measure.bed
+  done
+  if [ "$PEER_BEDS" = "$first_bed" ]; then mv "$(bed_dir $peer $first_bed).measure.bed" $peer.measure
+  else
+    for b in $PEER_BEDS; do (. ./$(bed_dir $peer $b).measure.bed; echo "$angle $csa $frames"); done | awk '
+      {a += $1; aa += $1 * $1; c += $2; cc += $2 * $2; f += $3; n++}
+      END {printf "frames=%d\nbeds=%d\nangle=%.3f\nangle_sd=%.3f\ncsa=%.3f\ncsa_sd=%.3f\n", f, n, a / n,
+           sqrt((aa - a * a / n) / (n - 1)), c / n, sqrt((cc - c * c / n) / (n - 1))}' > $peer.measure
+  fi
+  "$DP" measure drum.yaml $(bed_dir $peer $first_bed)/bed.dump "${sets[@]}" > $peer.bed
 done
 tol_a=$(awk -v s="$g_angle_sd" -v f=$SD_FLOOR_ANGLE 'BEGIN {printf "%.3f", 3 * (s > f ? s : f)}')
 tol_c=$(awk -v s="$g_csa_sd" -v f=$SD_FLOOR_CSA 'BEGIN {printf "%.3f", 3 * (s > f ? s : f)}')
@@ -129,20 +151,22 @@ tol_c=$(awk -v s="$g_csa_sd" -v f=$SD_FLOOR_CSA 'BEGIN {printf "%.3f", 3 * (s > 
   printf '%-10s %6.2f sd %5.2f (seeds) %6.2f sd %5.2f (seeds) %s\n' granucal "$g_angle" "$g_angle_sd" "$g_csa" "$g_csa_sd" \
     "3 seeds (seed,angle,CSA,granules): $(tr '\n' ' ' < granucal.csv)"
   fails=0
-  echo "code,angle_deg,angle_sd,csa_pct,csa_sd,frames,dt_fraction" > peers.csv
-  echo "granucal,$g_angle,$g_angle_sd,$g_csa,$g_csa_sd,3 seeds,own" >> peers.csv
-  echo "tolerance,$tol_a,,$tol_c,,," >> peers.csv
+  echo "code,angle_deg,angle_sd,csa_pct,csa_sd,frames,dt_fraction,beds" > peers.csv
+  echo "granucal,$g_angle,$g_angle_sd,$g_csa,$g_csa_sd,3 seeds,own,1 2 3" >> peers.csv
+  echo "tolerance,$tol_a,,$tol_c,,,," >> peers.csv
   for peer in $PEERS; do
     (. ./$peer.measure
      da=$(awk -v p="$angle" -v g="$g_angle" 'BEGIN {printf "%.2f", p - g}')
      dc=$(awk -v p="$csa" -v g="$g_csa" 'BEGIN {printf "%.2f", p - g}')
      ok=$(awk -v a="$da" -v c="$dc" -v ta="$tol_a" -v tc="$tol_c" 'BEGIN {print (a*a <= ta*ta && c*c <= tc*tc) ? "agrees" : "DISAGREES"}')
-     granules=$(sed -n 's/^granucal deck: \([0-9]*\) granules after the cut/\1/p' $peer/$peer.out | head -1)
+     d0=$(bed_dir $peer $first_bed) over=time
+     [ "$PEER_BEDS" = "$first_bed" ] || over=beds
+     granules=$(sed -n 's/^granucal deck: \([0-9]*\) granules after the cut/\1/p' $d0/$peer.out | head -1)
      bed_csa=$(. ./$peer.bed; echo "$csa")
-     printf '%-10s %6.2f sd %5.2f (time)  %6.2f sd %5.2f (time)  diff %+.2f deg %+.2f pts, %s (%d frames; %s granules, bed at rest CSA %.2f; %s wall)\n' \
-       $peer "$angle" "$angle_sd" "$csa" "$csa_sd" "$da" "$dc" "$ok" "$frames" "$granules" "$bed_csa" \
-       "$(grep real $peer/$peer.time | awk '{print $2}')"
-     echo "$peer,$angle,$angle_sd,$csa,$csa_sd,$frames,${DT_FRACTION:-deck}" >> peers.csv
+     printf '%-10s %6.2f sd %5.2f (%s)  %6.2f sd %5.2f (%s)  diff %+.2f deg %+.2f pts, %s (%d frames, beds %s; bed %s: %s granules, at rest CSA %.2f, %s wall)\n' \
+       $peer "$angle" "$angle_sd" $over "$csa" "$csa_sd" $over "$da" "$dc" "$ok" "$frames" "$PEER_BEDS" "$first_bed" \
+       "$granules" "$bed_csa" "$(grep real $d0/$peer.time | awk '{print $2}')"
+     echo "$peer,$angle,$angle_sd,$csa,$csa_sd,$frames,${DT_FRACTION:-deck},$PEER_BEDS" >> peers.csv
      [ "$ok" = agrees ]) || fails=$((fails + 1))
   done
   echo "tolerance: angle +-$tol_a deg, CSA +-$tol_c points (3 x max(seed SD here, ci tier's at 40 rpm))"
