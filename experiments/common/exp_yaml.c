@@ -133,3 +133,11 @@ const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN])
     const char *leaf = strrchr(field, '.');
     return leaf ? leaf + 1 : field;
 }
+
+int exp_seed_check(const char *path, int seed, char *err, size_t len)
+{
+    if (seed >= 0) return 0;
+    char msg[64];
+    snprintf(msg, sizeof msg, "seed = %d: must be >= 0", seed);
+    return exp_field_error(path, 0, NULL, "seed", msg, err, len);
+}

@@ -43,4 +43,9 @@ const char *exp_message_field(const char *msg, char field[EXP_FIELD_LEN]);
 int exp_field_error(const char *path, int n_sets, char *const *sets, const char *field, const char *msg, char *err,
                     size_t len);
 
+/// A config's `seed`: the definitions hold it as a uint64_t, so a negative one
+/// (it would wrap) is refused at its line in the file (`--set seed=` refuses
+/// one itself, exp_apply_set). 0, or 1 with the located error.
+int exp_seed_check(const char *path, int seed, char *err, size_t len);
+
 #endif

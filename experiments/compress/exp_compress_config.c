@@ -73,11 +73,7 @@ int exp_compress_load(const char *path, int n_sets, char **sets, exp_compress_de
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
     if (!bad && strcmp(y->experiment, "compression") != 0)
         bad = exp_field_error(path, 0, NULL, "experiment", "must be compression", err, len);
-    // The seed is a uint64_t of the definition: a negative one would wrap.
-    if (!bad && y->seed < 0) {
-        snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
-        bad = exp_field_error(path, 0, NULL, "seed", msg, err, len);
-    }
+    if (!bad) bad = exp_seed_check(path, y->seed, err, len);
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_compress_check(d, msg, sizeof msg))) {
         // Messages start with the field ("sigma_max = ...", "granule_contact.mu_s = ...").
         char field[EXP_FIELD_LEN];

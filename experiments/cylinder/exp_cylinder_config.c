@@ -68,10 +68,7 @@ int exp_cylinder_load(const char *path, int n_sets, char **sets, exp_cylinder_de
     for (int k = 0; k < n_sets && !bad; ++k) bad = apply_set(y, sets[k], err, len);
     if (!bad && strcmp(y->experiment, "cylinder") != 0)
         bad = exp_field_error(path, 0, NULL, "experiment", "must be cylinder", err, len);
-    if (!bad && y->seed < 0) {
-        snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
-        bad = exp_field_error(path, 0, NULL, "seed", msg, err, len);
-    }
+    if (!bad) bad = exp_seed_check(path, y->seed, err, len);
     if (!bad && (to_def(y, d, msg, sizeof msg) || exp_cylinder_check(d, msg, sizeof msg))) {
         // Messages start with the field: "depth = ...", "granule_contact.mu_s = ...",
         // "gsd.geometric_sd = ..."; the YAML key is the last part.

@@ -87,11 +87,7 @@ int exp_silo_load(const char *path, int n_sets, char **sets, exp_silo_def *d, ch
         snprintf(msg, sizeof msg, "n_granules = %d: must be >= 1", y->n_granules);
         bad = exp_field_error(path, n_sets, sets, "n_granules", msg, err, len);
     }
-    // The seed is a uint64_t of the definition: a negative one would wrap.
-    if (!bad && y->seed < 0) {
-        snprintf(msg, sizeof msg, "seed = %d: must be >= 0", y->seed);
-        bad = exp_field_error(path, n_sets, sets, "seed", msg, err, len);
-    }
+    if (!bad) bad = exp_seed_check(path, y->seed, err, len);
     if (!bad) {
         to_def(y, d);
         if (exp_silo_check(d, msg, sizeof msg))
