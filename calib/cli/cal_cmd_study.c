@@ -177,7 +177,7 @@ static int narrow_speeds(cal_fidelity *f, const char *list, const char *path, ch
 static cal_drum_case case_of(const study *s, const cal_tier *r, int seed)
 {
     cal_drum_case d = cal_drum_case_granule(s->c, r, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
-    d.def.seed = d.fill.seed = (uint64_t)(s->c->seed + seed);
+    cal_drum_case_set_seed(&d, (uint64_t)(s->c->seed + seed));
     return d;
 }
 

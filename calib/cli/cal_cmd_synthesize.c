@@ -205,7 +205,7 @@ static cal_drum_case case_of(const job *j, const lining *l, long seed)
 {
     cal_drum_case d = l->wall ? cal_drum_case_wall(j->c, j->t, j->k_n, j->gg_mu_s, j->gg_mu_r, l->wall->mu_s, l->wall->mu_r)
                               : cal_drum_case_granule(j->c, j->t, j->k_n, j->gg_mu_s, j->gg_mu_r);
-    d.def.seed = d.fill.seed = (uint64_t)seed;
+    cal_drum_case_set_seed(&d, (uint64_t)seed);
     return d;
 }
 

@@ -50,6 +50,9 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_SEQUENCE("average_time_per_rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, average_time_per_rpm,
                          &float_entry, 1, 32),
     CYAML_FIELD_SEQUENCE("rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, rpm, &float_entry, 0, 32),
+    CYAML_FIELD_SEQUENCE("turned_start_rpm", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, turned_start_rpm,
+                         &float_entry, 1, 32),
+    TIER_FLOAT("turned_start_time", turned_start_time, CYAML_FLAG_OPTIONAL),
     TIER_FLOAT("cylinder_lambda", cylinder_lambda, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_SEQUENCE("stiffness", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, stiffness, &float_entry, 2, 64),
     CYAML_FIELD_ENUM_PTR("stiffness_scene", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, stiffness_scene,
@@ -175,8 +178,9 @@ static int check_steady_rule(const cal_config *c, int from, const cal_tier *t, c
     if (t->steady_rule && exp_drum_steady_rule_from_name(t->steady_rule, &rule))
         return located(c, from, "steady_rule", err, len, "'%s': use windows or mser", t->steady_rule);
     if (rule != EXP_STEADY_MSER) {
-        if (t->steady_se_angle_deg != 0 || t->steady_se_csa_percent != 0)
-            return located(c, from, "steady_se_angle_deg", err, len, "the standard error targets need steady_rule: mser");
+        if ((t->steady_se_angle_deg != 0 || t->steady_se_csa_percent != 0) && t->turned_start_rpm_count == 0)
+            return located(c, from, "steady_se_angle_deg", err, len,
+                           "the standard error targets need steady_rule: mser or turned_start_rpm");
         return 0;
     }
     if (bad_positive(t->steady_se_angle_deg) || bad_positive(t->steady_se_csa_percent))
@@ -278,6 +282,33 @@ static int check_average_per_rpm(const cal_config *c, const cal_tier *t, int fro
     return 0;
 }
 
+// Turned starts: speeds of the tier's own, a time to turn the bed first, and
+// MSER's targets (it stops those runs: no averaging time at those speeds).
+static int check_turned_start(const cal_config *c, const cal_tier *t, int from, char *err, size_t len)
+{
+    if (t->turned_start_rpm_count == 0) {
+        if (t->turned_start_time != 0)
+            return located(c, from, "turned_start_time", err, len, "give turned_start_rpm: the speeds it applies to");
+        return 0;
+    }
+    if (!(isfinite(t->turned_start_time) && t->turned_start_time > 0 && t->turned_start_time <= 600))
+        return located(c, from, "turned_start_time", err, len, "%g must be in (0, 600] s of turning",
+                       t->turned_start_time);
+    if (bad_positive(t->steady_se_angle_deg) || bad_positive(t->steady_se_csa_percent))
+        return located(c, from, "turned_start_rpm", err, len,
+                       "a turned start's runs stop by MSER: give steady_se_angle_deg and steady_se_csa_percent > 0");
+    for (unsigned k = 0; k < t->turned_start_rpm_count; ++k) {
+        double r = t->turned_start_rpm[k];
+        int listed = 0;
+        for (unsigned j = 0; j < t->rpm_count; ++j) listed |= t->rpm[j] == r;
+        if (!listed) return located(c, from, "turned_start_rpm", err, len, "%g is not one of the tier's rpm", r);
+        if (cal_tier_average_time(t, r) > 0)
+            return located(c, from, "average_time_per_rpm", err, len,
+                           "%g rpm starts turned and stops by MSER: give it an averaging time of 0", r);
+    }
+    return 0;
+}
+
 // Stage 1's candidates (the config's, or a tier's from its line on): each > 0, increasing.
 static int check_stiffness(const cal_config *c, int from, const double *k, unsigned n, char *err, size_t len)
 {
@@ -323,6 +354,7 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
             return located(c, from, "csa_sd_percent", err, len, "%g must be in [0, 50) percentage points",
                            t->csa_sd_percent[k]);
     if (check_average_per_rpm(c, t, from, err, len)) return 1;
+    if (check_turned_start(c, t, from, err, len)) return 1;
     if (t->map_correction && !t->map_tier)
         return located(c, from, "map_correction", err, len, "only a tier with a map_tier corrects a map");
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
@@ -337,7 +369,8 @@ const char *cal_tier_calibration_key(const cal_tier *t)
         {"max_evaluations", t->max_evaluations != 0}, {"angle_sd_deg", t->angle_sd_deg != 0},
         {"angle_rule", t->angle_rule != NULL}, {"csa_sd_percent", t->csa_sd_percent_count > 0},
         {"bound_probes", t->bound_probes != NULL}, {"map_tier", t->map_tier != NULL},
-        {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL}};
+        {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL},
+        {"turned_start_rpm", t->turned_start_rpm_count > 0}, {"turned_start_time", t->turned_start_time != 0}};
     for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k)
         if (keys[k].given) return keys[k].key;
     return NULL;
@@ -379,6 +412,13 @@ double cal_tier_average_time(const cal_tier *t, double rpm)
     for (unsigned k = 0; k < t->average_time_per_rpm_count && k < t->rpm_count; ++k)
         if (t->rpm[k] == rpm) return t->average_time_per_rpm[k];
     return t->average_time;
+}
+
+int cal_tier_turned_start(const cal_tier *t, double rpm)
+{
+    for (unsigned k = 0; k < t->turned_start_rpm_count; ++k)
+        if (t->turned_start_rpm[k] == rpm) return 1;
+    return 0;
 }
 
 static int check_fidelity(const cal_config *c, char *err, size_t len)

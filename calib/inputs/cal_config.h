@@ -58,6 +58,18 @@ typedef struct cal_tier {
     /// flows steadily and needs far less for its CSA.
     double *average_time_per_rpm;
     unsigned average_time_per_rpm_count;
+    /// Speeds whose runs start from a turned bed instead of a level one
+    /// (absent: none). Per seed, the stage's bed, poured with its fill pair
+    /// (the granule stage: pour_mu_s, pour_mu_r; the wall stage: the frozen
+    /// granule pair), is turned turned_start_time s at that speed once, and
+    /// every candidate's run at it starts from there without the start tilt;
+    /// MSER (steady_se_angle_deg, steady_se_csa_percent) cuts the transient
+    /// of the change of pair and stops the run. Why: from a level bed a 4 rpm
+    /// run still compacts for ~8 s, and the windows' test then reads its
+    /// angle ~1.4° high at λ 1000 (results/steady_rule/turned_start/).
+    double *turned_start_rpm;
+    unsigned turned_start_rpm_count;
+    double turned_start_time;
     double *rpm;            ///< speeds simulated; empty = every speed in the data
     unsigned rpm_count;
     double cylinder_lambda; ///< coarse-graining factor of the poured cylinder (stage 1)
@@ -129,6 +141,8 @@ double cal_tier_csa_sd(const cal_tier *t, unsigned i);
 /// Seconds a run at `rpm` averages after its steady test: average_time_per_rpm's
 /// entry for that speed, else average_time.
 double cal_tier_average_time(const cal_tier *t, double rpm);
+/// 1 if the tier's runs at `rpm` start from a turned bed (turned_start_rpm).
+int cal_tier_turned_start(const cal_tier *t, double rpm);
 
 /// The first key of a calibration tier alone that t gives (a value other
 /// than 0 or absent), NULL if none: a rung of the fidelity study may not.

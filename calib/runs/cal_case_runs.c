@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cal_files.h"
 #include "cal_mpi.h"
@@ -40,7 +41,7 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
                           .mu_s = gg_mu_s, .mu_r = gg_mu_r, .wall_mu_s = wall_mu_s, .wall_mu_r = wall_mu_r,
                           .fill_method = exp_default_drum_def().fill_method, .seed = (uint64_t)c->seed};
     if (t->fill_method) exp_drum_fill_method_from_name(t->fill_method, &p.fill_method); // checked on loading
-    cal_drum_case d;
+    cal_drum_case d = {0};
     d.def = exp_drum_def_from_physics(&p);
     d.run = exp_default_drum_run_opts();
     d.run.average_time = t->average_time;
@@ -53,20 +54,34 @@ static cal_drum_case drum_case(const cal_config *c, const cal_tier *t, double k_
     if (t->steady_csa_tol_percent > 0) d.run.csa_tol_percent = t->steady_csa_tol_percent;
     if (t->steady_rule) exp_drum_steady_rule_from_name(t->steady_rule, &d.run.steady_rule); // checked on loading
     d.run.se_angle_deg = t->steady_se_angle_deg, d.run.se_csa_percent = t->steady_se_csa_percent;
-    d.fill = d.def;
+    for (unsigned k = 0; k < t->turned_start_rpm_count && k < CAL_CASE_MAX_RPM; ++k)
+        d.turned_rpm[d.n_turned++] = t->turned_start_rpm[k];
+    d.turned_time = t->turned_start_time;
+    d.fill = d.start = d.def;
     return d;
+}
+
+void cal_drum_case_set_seed(cal_drum_case *d, uint64_t seed) { d->def.seed = d->fill.seed = d->start.seed = seed; }
+
+int cal_drum_case_turned(const cal_drum_case *c, double rpm)
+{
+    for (int k = 0; k < c->n_turned; ++k)
+        if (c->turned_rpm[k] == rpm) return 1;
+    return 0;
 }
 
 cal_drum_case cal_drum_case_granule(const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r)
 {
-    return drum_case(c, t, k_n, mu_s, mu_r, mu_s, mu_r);
+    cal_drum_case d = drum_case(c, t, k_n, mu_s, mu_r, mu_s, mu_r);
+    d.start = drum_case(c, t, k_n, c->pour_mu_s, c->pour_mu_r, c->pour_mu_s, c->pour_mu_r).def;
+    return d;
 }
 
 cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
                                  double wall_mu_s, double wall_mu_r)
 {
     cal_drum_case d = drum_case(c, t, k_n, gg_mu_s, gg_mu_r, wall_mu_s, wall_mu_r);
-    d.fill = drum_case(c, t, k_n, gg_mu_s, gg_mu_r, gg_mu_s, gg_mu_r).def;
+    d.fill = d.start = drum_case(c, t, k_n, gg_mu_s, gg_mu_r, gg_mu_s, gg_mu_r).def;
     return d;
 }
 
@@ -131,7 +146,32 @@ exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm)
     run.rpm = rpm;
     for (int k = 0; k < c->n_average; ++k)
         if (c->average_rpm[k] == rpm) run.average_time = c->average_time[k];
+    if (cal_drum_case_turned(c, rpm)) { // from the turned bed: no tilt; MSER cuts the change of pair
+        run.start_tilt_deg = 0, run.average_time = 0;
+        run.steady_rule = EXP_STEADY_MSER;
+    }
     return run;
+}
+
+// How that bed is turned first: the tier's run at `rpm`, for turned_time s,
+// from the level bed with the tier's start tilt, every sample kept as the
+// window (the windows' test cannot hold: nothing is averaged or stopped early).
+static exp_drum_run_opts start_turn_opts(const cal_drum_case *c, double rpm)
+{
+    exp_drum_run_opts o = c->run;
+    o.rpm = rpm, o.max_time = o.window = c->turned_time, o.average_time = 0;
+    o.steady_rule = EXP_STEADY_WINDOWS;
+    return o;
+}
+
+// The text that defines a turned bed: its drum and pairs, and its turn.
+static void start_bed_key(const cal_drum_case *c, double rpm, char *out, size_t len)
+{
+    const exp_drum_run_opts o = start_turn_opts(c, rpm);
+    char def[1024];
+    drum_def_text(&c->start, def, sizeof def);
+    snprintf(out, len, "turned_bed %s rpm=%.10g time=%.10g sample=%.10g network_dt=%d start_tilt=%.10g", def, rpm,
+             o.max_time, o.sample_interval, o.adopt_network_dt, o.start_tilt_deg);
 }
 
 void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
@@ -154,6 +194,12 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
     if (r->average_time > 0) snprintf(out + strlen(out), len - strlen(out), " average_time=%.10g", r->average_time);
     if (r->steady_rule == EXP_STEADY_MSER)
         snprintf(out + strlen(out), len - strlen(out), " steady=mser se=%.10g,%.10g", r->se_angle_deg, r->se_csa_percent);
+    if (cal_drum_case_turned(c, rpm)) {
+        char granule[160], wall[160];
+        contact_text(granule, sizeof granule, &c->start.granule), contact_text(wall, sizeof wall, &c->start.wall);
+        snprintf(out + strlen(out), len - strlen(out), " start=turned[time=%.10g tilt=%.10g granule[%s] wall[%s]]",
+                 c->turned_time, c->run.start_tilt_deg, granule, wall);
+    }
 }
 
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
@@ -247,6 +293,15 @@ typedef struct drum_batch {
     int n_case_todo;
     dem_world *bed;        ///< the shared bed (shared_fill)
     double bed_wall_s;
+    // Runs from turned beds (run_turned): todo[turned_from..n_todo), each
+    // with its bed and the bed's cost charged to it; the beds made side by
+    // side first (prep, their hashes prepped).
+    int turned_from;
+    dem_world **turned_bed;
+    double *turned_charge;
+    drum_run *prep;
+    char (*prepped)[17];
+    int n_prep;
 } drum_batch;
 
 static const char *run_key(const drum_batch *b, drum_run r) { return b->keys[r.c * b->n_rpm + r.k]; }
@@ -284,7 +339,7 @@ static void checkpoint_path(const cal_env *env, const char *key, char *out, size
 // "[PP] 4 rpm, seed 2: turn t = 3.2 s, 2827 granules, wall 600 s".
 enum { HEARTBEAT_EVERY_S = 600 };
 typedef struct heartbeat {
-    char label[128]; ///< "[stage] what": a stage name is < 64, what < 48
+    char label[160]; ///< "[stage] what": a stage name is < 64, what < 64
     exp_progress_printer printer; ///< prints label; keep the heartbeat where it was started
 } heartbeat;
 
@@ -444,6 +499,73 @@ void cal_sim_release(cal_env *env)
     dem_world_destroy(env->kept_bed);
     env->kept_bed = NULL;
     env->kept_text[0] = 0;
+    for (int k = 0; k < env->n_turned; ++k) dem_world_destroy(env->turned[k].bed);
+    free(env->turned);
+    env->turned = NULL, env->n_turned = 0;
+}
+
+// ---- turned starts (cal_drum_case.n_turned) ---------------------------------
+
+// A turned bed's hash (its store name) and file: it is a checkpoint of its
+// own turn, kept when the turn ends (exp_drum_turn.checkpoint_at_end).
+static void turned_bed_hash(const cal_drum_case *c, double rpm, char *key, size_t len, char hash[17])
+{
+    start_bed_key(c, rpm, key, len);
+    cal_store_hash(key, hash);
+}
+
+static void turned_bed_path(const cal_env *env, const char *hash, char *out, size_t len)
+{
+    snprintf(out, len, "%s/%s.start.h5", env->store, hash);
+}
+
+// Case c's start bed poured and turned at `rpm`, resumed from (and saved to)
+// its file in the store: once turned, a later process pours it again (a
+// pour's cost) and takes the turn from the file. NULL with a message if it
+// failed. *turn_s: the wall time of the turn, with what came before its file.
+static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, double rpm, double *fill_s,
+                                  exp_drum_result *res, char *err, size_t len)
+{
+    char key[2048], hash[17], path[1300], what[64], prefix[80];
+    turned_bed_hash(c, rpm, key, sizeof key, hash);
+    turned_bed_path(env, hash, path, sizeof path);
+    double t0 = exp_wall_seconds();
+    heartbeat h;
+    heartbeat_of_bed(&h, env->stage, &c->start);
+    dem_world *bed = exp_drum_fill(&c->start, exp_print_progress, &h.printer, err, len);
+    *fill_s = exp_wall_seconds() - t0;
+    if (!bed) return NULL;
+    snprintf(what, sizeof what, "the turned bed of seed %llu, %g rpm", (unsigned long long)c->start.seed, rpm);
+    snprintf(prefix, sizeof prefix, "[%s]", env->stage);
+    heartbeat_start(&h, env->stage, what);
+    exp_drum_turn turn = {.def = &c->start, .run = start_turn_opts(c, rpm), .checkpoint_path = path, .key = key,
+                          .checkpoint_every_s = env->checkpoint_every_s, .checkpoint_at_end = 1,
+                          .progress = exp_print_progress, .progress_ctx = &h.printer, .log_prefix = prefix};
+    dem_status st;
+    exp_drum_turn_bed(bed, 1, &turn, res, &st);
+    if (st == DEM_OK) return bed;
+    exp_fail(err, len, "%s (%g s at %g rpm) failed: %s", what, c->turned_time, rpm, dem_world_error(bed));
+    dem_world_destroy(bed);
+    return NULL;
+}
+
+static struct cal_turned_bed *kept_turned(cal_env *env, const char *hash)
+{
+    for (int k = 0; k < env->n_turned; ++k)
+        if (strcmp(env->turned[k].hash, hash) == 0) return &env->turned[k];
+    return NULL;
+}
+
+// Keep a turned bed for the rest of the process (a stage's beds are its seeds: a few).
+static struct cal_turned_bed *keep_turned(cal_env *env, dem_world *bed, const char *hash, double wall_s)
+{
+    struct cal_turned_bed *more = realloc(env->turned, (size_t)(env->n_turned + 1) * sizeof *more);
+    if (!more) return NULL;
+    env->turned = more;
+    struct cal_turned_bed *t = &env->turned[env->n_turned++];
+    t->bed = bed, t->wall_s = wall_s;
+    snprintf(t->hash, sizeof t->hash, "%s", hash);
+    return t;
 }
 
 // The settled bed of this fill definition: the kept one, or a new one (whose
@@ -476,8 +598,113 @@ static int one_fill(const drum_batch *b, const drum_run *missing, int n_missing)
     return 1;
 }
 
-// Deal the missing runs over the ranks and run this rank's share.
-static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missing)
+// Pool task: make one turned bed into its file in the store; the parent
+// then takes it from there (a pour and the file).
+static int prepare_turned(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    const drum_run r = b->prep[i];
+    double fill_s;
+    exp_drum_result res;
+    char err[1024];
+    dem_world *bed = make_turned_bed(b->env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
+    if (!bed) return fprintf(stderr, "[%s] %s\n", b->env->stage, err), 1;
+    dem_world_destroy(bed);
+    return 0;
+}
+
+static void prepared(int i, int code, void *ctx) { (void)i, (void)code, (void)ctx; }
+
+static int listed_hash(char (*hashes)[17], int n, const char *hash)
+{
+    for (int k = 0; k < n; ++k)
+        if (strcmp(hashes[k], hash) == 0) return 1;
+    return 0;
+}
+
+// The turned beds of runs[0..n) that this process does not keep and the
+// store has no file of, made side by side when there are several (by rank
+// 0: every rank then takes them from the store). Their hashes in
+// b->prepped: made now, so their whole turn is this process's cost.
+static void prepare_turned_beds(drum_batch *b, const drum_run *runs, int n)
+{
+    b->prep = calloc((size_t)n, sizeof *b->prep);
+    char(*todo)[17] = calloc((size_t)n, sizeof *todo);
+    b->prepped = todo;
+    for (int i = 0; i < n && b->prep && todo && cal_mpi_rank() == 0; ++i) {
+        char key[2048], hash[17], path[1300];
+        turned_bed_hash(&b->cases[runs[i].c], b->rpm[runs[i].k], key, sizeof key, hash);
+        turned_bed_path(b->env, hash, path, sizeof path);
+        if (kept_turned(b->env, hash) || access(path, F_OK) == 0 || listed_hash(todo, b->n_prep, hash)) continue;
+        snprintf(todo[b->n_prep], sizeof todo[0], "%s", hash);
+        b->prep[b->n_prep++] = runs[i];
+    }
+    // One bed alone is made by the process that keeps it (run_turned), without a second pour;
+    // so is every bed where no file is kept (--checkpoint-every 0).
+    if (b->n_prep > 1 && b->env->checkpoint_every_s > 0) cal_pool_run(b->n_prep, prepare_turned, prepared, b, b->env->workers, b->env->use_fork);
+    else b->n_prep = 0;
+    cal_mpi_barrier(); // the files are on the shared store now
+}
+
+// Run i of this rank's share from its turned bed: a task turning a copy of it.
+static int turn_from_turned(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    if (!b->turned_bed[i]) return 1; // its bed failed: recorded as failed
+    return turn_and_store(b, b->turned_bed[i], b->todo[b->turned_from + i], b->turned_charge[i], b->env->use_fork, 0);
+}
+
+static void turned_from_turned(int i, int code, void *ctx)
+{
+    drum_batch *b = ctx;
+    show_run(b, b->todo[b->turned_from + i], code, b->n_cases);
+}
+
+// The turned bed of run r, kept or made now (NULL: it failed; the run is
+// recorded failed). *charge: its cost to this process, charged once.
+static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
+{
+    cal_env *env = b->env;
+    char key[2048], hash[17], path[1300], err[1024];
+    turned_bed_hash(&b->cases[r.c], b->rpm[r.k], key, sizeof key, hash);
+    struct cal_turned_bed *t = kept_turned(env, hash);
+    if (!t) {
+        turned_bed_path(env, hash, path, sizeof path);
+        double fill_s;
+        exp_drum_result res;
+        dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
+        if (!bed) return write_failed(env, run_key(b, r), err), NULL;
+        // A file made by an earlier process was charged there; one made now by a worker, here.
+        double turn_s = res.wall_time_s - (listed_hash(b->prepped, b->n_prep, hash) ? 0 : res.earlier_wall_s);
+        t = keep_turned(env, bed, hash, fill_s + turn_s);
+        if (!t) return dem_world_destroy(bed), write_failed(env, run_key(b, r), "out of memory keeping the turned bed"), NULL;
+    }
+    *charge = t->wall_s, t->wall_s = 0;
+    return t->bed;
+}
+
+// The runs that start from a turned bed: the beds first, then this rank's
+// share of the runs, each a task.
+static void run_turned(drum_batch *b, const drum_run *runs, int n)
+{
+    prepare_turned_beds(b, runs, n);
+    int rank = cal_mpi_rank(), size = cal_mpi_size();
+    b->turned_from = b->n_todo;
+    for (int i = 0; i < n; ++i)
+        if (i % size == rank) b->todo[b->n_todo++] = runs[i];
+    int m = b->n_todo - b->turned_from;
+    b->turned_bed = calloc((size_t)m + 1, sizeof *b->turned_bed);
+    b->turned_charge = calloc((size_t)m + 1, sizeof *b->turned_charge);
+    if (!b->turned_bed || !b->turned_charge) {
+        for (int j = 0; j < m; ++j) write_failed(b->env, run_key(b, b->todo[b->turned_from + j]), "out of memory");
+        return;
+    }
+    for (int j = 0; j < m; ++j) b->turned_bed[j] = turned_bed_of(b, b->todo[b->turned_from + j], &b->turned_charge[j]);
+    if (m > 0) cal_pool_run(m, turn_from_turned, turned_from_turned, b, b->env->workers, b->env->use_fork);
+}
+
+// The runs from a level bed: dealt over the ranks, this rank's share run.
+static void run_missing_level(drum_batch *b, const drum_run *missing, int n_missing)
 {
     int rank = cal_mpi_rank(), size = cal_mpi_size();
     if (one_fill(b, missing, n_missing)) { // runs dealt one by one
@@ -502,6 +729,25 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
         for (int j = 0; j < b->n_case_todo; ++j)
             if (missing[i].c == b->case_todo[j]) b->todo[b->n_todo++] = missing[i];
     if (b->n_case_todo > 0) cal_pool_run(b->n_case_todo, settle_and_turn, settled_and_turned, b, b->env->workers, b->env->use_fork);
+}
+
+// Deal the missing runs over the ranks and run this rank's share: those
+// from a level bed, then those from a turned one.
+static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missing)
+{
+    drum_run *level = calloc((size_t)n_missing, sizeof *level), *turned = calloc((size_t)n_missing, sizeof *turned);
+    int n_level = 0, n_turned = 0;
+    if (!level || !turned) {
+        for (int i = 0; i < n_missing; ++i) write_failed(b->env, run_key(b, missing[i]), "out of memory");
+        return free(level), free(turned);
+    }
+    for (int i = 0; i < n_missing; ++i) {
+        if (cal_drum_case_turned(&b->cases[missing[i].c], b->rpm[missing[i].k])) turned[n_turned++] = missing[i];
+        else level[n_level++] = missing[i];
+    }
+    if (n_level > 0) run_missing_level(b, level, n_level);
+    if (n_turned > 0) run_turned(b, turned, n_turned);
+    free(level), free(turned);
 }
 
 // A record found in the store: a simulation done, at the cost it had; then released.
@@ -549,6 +795,7 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     if (bad) // the caller gets no records: release those read
         while (read > 0) cal_record_free(&out[--read]);
     free(b.keys), free(b.todo), free(b.case_todo), free(missing);
+    free(b.turned_bed), free(b.turned_charge), free(b.prep), free(b.prepped);
     return bad;
 }
 

@@ -37,6 +37,16 @@ typedef struct cal_env {
     /// settled once per process. Freed by cal_sim_release.
     dem_world *kept_bed;
     char kept_text[1024];
+    /// Turned beds (cal_drum_case.start turned at a speed), by the hash of
+    /// their text, kept for this process's later candidates; wall_s: what
+    /// making one cost this process, charged to the first run that starts
+    /// from it. Freed by cal_sim_release.
+    struct cal_turned_bed {
+        dem_world *bed;
+        char hash[17];
+        double wall_s;
+    } *turned;
+    int n_turned;
 } cal_env;
 
 /// Name the stage that progress lines are labelled with.
@@ -58,7 +68,21 @@ typedef struct cal_drum_case {
     /// average_time_per_rpm); read through cal_drum_run_opts.
     int n_average;
     double average_rpm[CAL_CASE_MAX_RPM], average_time[CAL_CASE_MAX_RPM];
+    /// Speeds whose runs start from a turned bed (a tier's turned_start_rpm;
+    /// 0: none): the fill's drum and seed poured and turned turned_time s at
+    /// that speed with the start pairs, once for every candidate that shares
+    /// them; the run then goes on from there with its own pairs, without the
+    /// start tilt, stopped by MSER (cal_drum_run_opts).
+    int n_turned;
+    double turned_rpm[CAL_CASE_MAX_RPM], turned_time;
+    exp_drum_def start; ///< the turned bed's drum (the fill's) and pairs
 } cal_drum_case;
+
+/// Every bed of case d (its turn, fill and turned start) on `seed`.
+void cal_drum_case_set_seed(cal_drum_case *d, uint64_t seed);
+
+/// 1 if case c's runs at `rpm` start from its turned bed.
+int cal_drum_case_turned(const cal_drum_case *c, double rpm);
 
 /// The run options of case c turned at `rpm`: its speed, and its averaging
 /// time at that speed.
@@ -68,12 +92,15 @@ exp_drum_run_opts cal_drum_run_opts(const cal_drum_case *c, double rpm);
 /// granule stiffness k_n, settled and turned with that pair. The bed's
 /// packing, hence its CSA, depends on the granule pair, so each candidate
 /// settles its own bed (same seed: the same granules at the same places).
+/// A turned start's bed is the stage's own, poured and turned with the
+/// config's prior pair (pour_mu_s, pour_mu_r), shared by every candidate.
 cal_drum_case cal_drum_case_granule(const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r);
 
 /// Stage 3: the granule pair frozen, a wall material's pair (wall_mu_s,
 /// wall_mu_r). Every candidate turns the same bed, settled in the drum lined
 /// with granules: the wall changes only the boundary layer of a poured bed, so
 /// one fill serves the whole stage (a fill costs about as much as a turn).
+/// A turned start's bed is that fill turned in the granule-lined drum.
 cal_drum_case cal_drum_case_wall(const cal_config *c, const cal_tier *t, double k_n, double gg_mu_s, double gg_mu_r,
                                  double wall_mu_s, double wall_mu_r);
 

@@ -252,7 +252,7 @@ cal_drum_case cal_friction_case(const cal_config *c, const cal_tier *t, const ca
 {
     cal_drum_case d = r->material[0] ? cal_drum_case_wall(c, t, r->k_n, r->frozen_mu_s, r->frozen_mu_r, mu_s, mu_r)
                                      : cal_drum_case_granule(c, t, r->k_n, mu_s, mu_r);
-    d.def.seed = d.fill.seed = (uint64_t)(c->seed + bed); // bed 0: the config's seed, a one-bed tier's run
+    cal_drum_case_set_seed(&d, (uint64_t)(c->seed + bed)); // bed 0: the config's seed, a one-bed tier's run
     return d;
 }
 

@@ -505,6 +505,9 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     // them (average_time); under the MSER rule, every sample from its start.
     // Not steady: the last two windows.
     report_checks(w, check_wall_before, out);
+    if (o->checkpoint && o->checkpoint->at_end && st == DEM_OK &&
+        save_turn(w, o, &s, out, exp_wall_seconds() - started, out->checkpoint_note, sizeof out->checkpoint_note) == 0)
+        out->checkpoint_note[0] = '\0';
     out->steady = s.steady_from >= 0;
     int from = out->steady ? s.steady_from : s.count > 2 * per_window ? s.count - 2 * per_window : 0;
     out->averaged_time_s = (s.count - from) * o->sample_interval;

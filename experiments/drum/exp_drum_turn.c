@@ -20,7 +20,7 @@ dem_world *exp_drum_turn_bed(dem_world *bed, int own, const exp_drum_turn *t, ex
     dem_world *w = own ? bed : dem_world_clone(bed);
     if (!w) return NULL;
     exp_drum_run_opts run = t->run;
-    exp_drum_checkpoint ck = {t->checkpoint_path, t->key, t->checkpoint_every_s};
+    exp_drum_checkpoint ck = {t->checkpoint_path, t->key, t->checkpoint_every_s, t->checkpoint_at_end};
     run.checkpoint = ck.every_s > 0 ? &ck : NULL;
     double t0 = exp_wall_seconds();
     *status = exp_drum_rotate(w, t->def, &run, t->progress, t->progress_ctx, out);

@@ -18,6 +18,10 @@ typedef struct exp_drum_turn {
     const char *checkpoint_path; ///< where the turn saves its state
     const char *key;             ///< the text that defines the run: another run's checkpoint is not resumed
     double checkpoint_every_s;   ///< wall seconds between saves; <= 0: no checkpoint
+    /// 1: the checkpoint is also saved when the turn ends, and kept: the file
+    /// is then the turned bed, for runs that start from it (needs
+    /// checkpoint_every_s > 0).
+    int checkpoint_at_end;
     exp_progress_fn progress;    ///< may be NULL
     void *progress_ctx;
     /// 1: the progress leaves its last line open (a terminal's \r line),

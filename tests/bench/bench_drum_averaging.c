@@ -78,7 +78,7 @@ static int pre_turn_bed(dem_world *w, const cal_config *c, const cal_tier *t, do
     if (sscanf(spec, "%lf,%lf,%lf", &mu_s, &mu_r, &seconds) != 3 || !(seconds > 0))
         return fprintf(stderr, "PRE_TURN=%s: want MU_S,MU_R,SECONDS\n", spec), 1;
     cal_drum_case a = cal_drum_case_granule(c, t, k_n, mu_s, mu_r);
-    a.def.seed = a.fill.seed = (uint64_t)(c->seed + bed);
+    cal_drum_case_set_seed(&a, (uint64_t)(c->seed + bed));
     exp_drum_run_opts o = cal_drum_run_opts(&a, rpm);
     o.max_time = o.window = seconds; // every sample of the pre-turn kept, none averaged
     o.steady_rule = EXP_STEADY_WINDOWS;
@@ -101,7 +101,7 @@ int main(int argc, char **argv)
     const cal_tier *t = cal_config_tier(c);
     double rpm = atof(argv[6]);
     cal_drum_case d = cal_drum_case_granule(c, t, atof(argv[3]), atof(argv[4]), atof(argv[5]));
-    d.def.seed = d.fill.seed = (uint64_t)(c->seed + atoi(argv[7])); // as the friction stage sets a bed's seed
+    cal_drum_case_set_seed(&d, (uint64_t)(c->seed + atoi(argv[7]))); // as the friction stage sets a bed's seed
     cal_drum_key(&d, rpm, key, sizeof key);
     cal_record rec;
     const int got = cal_store_get(argv[8], key, &rec, err, sizeof err);

@@ -56,6 +56,10 @@ expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit
 expect "unknown steady rule" "steady_rule: 'eyeball': use windows or mser" -- "$(edit steady '0,/^    max_time: 1.5/s//    max_time: 1.5\n    steady_rule: eyeball/')" "${out[@]}"
 expect "mser without its targets" "steady_rule mser needs steady_se_angle_deg and steady_se_csa_percent > 0 (got 0.2, 0)" -- "$(edit mser_se '0,/^    max_time: 1.5/s//    max_time: 1.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2/')" "${out[@]}"
 expect "mser with an averaging time" "steady_rule: mser stops each run itself: give no average_time" -- "$(edit mser_avg '0,/^    max_time: 1.5/s//    max_time: 1.5\n    average_time: 0.5\n    steady_rule: mser\n    steady_se_angle_deg: 0.2\n    steady_se_csa_percent: 0.1/')" "${out[@]}"
+expect "turned start at a speed not turned" "turned_start_rpm: 40 is not one of the tier's rpm" -- "$(edit turned_rpm 's/turned_start_rpm: \[4\]/turned_start_rpm: [40]/')" "${out[@]}"
+expect "turned start of no time" "turned_start_time: -1 must be in (0, 600] s of turning" -- "$(edit turned_time 's/turned_start_time: 1.0/turned_start_time: -1/')" "${out[@]}"
+expect "turned start without MSER's targets" "turned_start_rpm: a turned start's runs stop by MSER: give steady_se_angle_deg and steady_se_csa_percent > 0" -- "$(edit turned_se '/steady_se_csa_percent: 1.0/d')" "${out[@]}"
+expect "turned speed with an averaging time" "average_time_per_rpm: 4 rpm starts turned and stops by MSER: give it an averaging time of 0" -- "$(edit turned_avg 's/    turned_start_time: 1.0/    turned_start_time: 1.0\n    average_time_per_rpm: [1.0, 0.5]/')" "${out[@]}"
 # A tier the user asked for names the option, the file and the tiers it has; one the file names, its line.
 tiers=$(sed -n 's/^  - name: \(.*\)/\1/p' "$work/configs/good.yaml" | paste -sd, | sed 's/,/, /g')
 expect "unknown --tier" "--tier fast: not a tier of $work/configs/good.yaml; its tiers: $tiers" -- "$work/configs/good.yaml" --tier fast "${out[@]}"
