@@ -467,6 +467,7 @@ typedef struct plan_pass {
     int parallel;
     int wall_grid_run[PLAN_MAX_TIERS]; ///< a wall stage of this tier ran its grid (expected figure)
     int wall_bed_kept[PLAN_MAX_TIERS]; ///< a one-bed wall stage of this tier settled its bed
+    int turned_made[PLAN_MAX_TIERS][2]; ///< this tier's turned beds of stage 2 [0], stage 3 [1] made (expected figure)
 } plan_pass;
 
 typedef struct plan {
@@ -579,6 +580,12 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
     double rpm[CAL_MAX_RPM];
     int speeds = cal_friction_speeds(r->c, t, &r->angles, &r->areas, m, rpm, NULL, err, len);
     if (speeds < 1) return 1;
+    int *turned_made = &pass->turned_made[tier_slot(r, t)][m != NULL]; // every wall stage starts from one bed
+    if (pass->worst || !*turned_made) {
+        cal_drum_case d = cal_drum_case_granule(r->c, t, pass->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
+        cal_plan_turned_beds(cost, &d, cal_tier_beds(t), pass->parallel);
+        *turned_made = 1;
+    }
     if (deciding) {
         for (int i = 0; i < t->max_evaluations; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
         return 0;

@@ -22,6 +22,17 @@ double cal_plan_makespan(const double *task_s, int n, int parallel)
     return fmax(longest, total / (parallel > 0 ? parallel : 1));
 }
 
+void cal_plan_turned_beds(cal_plan_cost *cost, const cal_drum_case *d, int beds, int parallel)
+{
+    const int n = beds * d->n_turned;
+    if (n <= 0) return;
+    exp_drum_cost unit = exp_drum_predict_cost(&d->start, 1.0);
+    const double bed_s = (unit.fill_particle_steps + unit.turn_particle_steps * d->turned_time) / CAL_PLAN_RATE;
+    cost->core_s += n * bed_s;
+    cost->wall_s += bed_s * ceil((double)n / (parallel > 0 ? parallel : 1));
+    cost->memory_mb = fmax(cost->memory_mb, unit.memory_mb);
+}
+
 void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const double *rpm, int n, int m, int beds,
                          int wall_stage, int bed_kept, int parallel, int worst)
 {

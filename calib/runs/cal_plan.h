@@ -48,6 +48,12 @@ void cal_plan_add(cal_plan *total, const cal_plan *p);
 /// simulations.csv: 10.05-10.75 s at 4 rpm, 4.0-4.1 s at 40 and 116).
 double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst);
 
+/// The turned beds of a stage whose tier starts some speeds turned
+/// (cal_drum_case.n_turned): one per bed (seed) and turned speed, each
+/// poured and turned turned_time s before the first run starts from it,
+/// side by side. Added to *cost once for the beds a process keeps.
+void cal_plan_turned_beds(cal_plan_cost *cost, const cal_drum_case *d, int beds, int parallel);
+
 /// m drum candidates like d, each on `beds` beds (seeds), turned at the n
 /// speeds rpm[], run together as one batch the way cal_drum_evaluate_many
 /// runs them: where every run settles the same bed (one candidate on one
