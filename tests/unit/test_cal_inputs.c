@@ -171,9 +171,13 @@ static void test_shipped_config_loads(void **state)
     assert_string_equal(map->name, "ci");
     assert_int_equal(cal_tier_beds(map), 2);
     assert_int_equal(map->rpm_count, standard->rpm_count);
-    // its 4 rpm drum avalanches and is averaged 8 s, the fast speeds flow and are averaged 2 s
-    assert_true(cal_tier_average_time(standard, 4) == 8 && cal_tier_average_time(standard, 40) == 2 &&
+    // its 4 rpm drum starts turned and MSER stops it (no averaging time); the fast speeds start
+    // level and are averaged 2 s
+    assert_true(cal_tier_average_time(standard, 4) == 0 && cal_tier_average_time(standard, 40) == 2 &&
                 cal_tier_average_time(standard, 116) == 2);
+    assert_true(cal_tier_turned_start(standard, 4) && !cal_tier_turned_start(standard, 40) &&
+                !cal_tier_turned_start(standard, 116));
+    assert_true(standard->turned_start_time == 10 && cal_tier_stiffness_on_drum(standard));
     cal_config_free(c);
     // fine-levels: three levels, lambda 512 on the standard tier's stage, itself on ci's
     c = cal_config_load(path, "fine-levels", err, sizeof err);
