@@ -293,10 +293,16 @@ typedef struct drum_batch {
     int n_case_todo;
     dem_world *bed;        ///< the shared bed (shared_fill)
     double bed_wall_s;
+    // Runs from a level bed: todo[0..n_level_todo), as n_level_tasks tasks
+    // of level_task (a run each on the shared bed, or a candidate each).
+    int n_level_todo, n_level_tasks;
+    cal_task_fn level_task;
+    cal_done_fn level_done;
     // Runs from turned beds (run_turned): todo[turned_from..n_todo), each
     // with its bed and the bed's cost charged to it; the beds made side by
     // side first (prep, their hashes prepped).
     int turned_from;
+    int n_turned_tasks;
     dem_world **turned_bed;
     double *turned_charge;
     drum_run *prep;
@@ -430,8 +436,8 @@ static int settle_and_turn(int i, void *ctx)
     dem_world *bed = exp_drum_fill(&b->cases[c].fill, exp_print_progress, &h.printer, err, sizeof err);
     double fill_s = exp_wall_seconds() - t0;
     int left = 0;
-    for (int j = 0; j < b->n_todo; ++j) left += b->todo[j].c == c;
-    for (int j = 0; j < b->n_todo; ++j) {
+    for (int j = 0; j < b->n_level_todo; ++j) left += b->todo[j].c == c;
+    for (int j = 0; j < b->n_level_todo; ++j) {
         if (b->todo[j].c != c) continue;
         --left;
         if (!bed) bad |= write_failed(b->env, run_key(b, b->todo[j]), err);
@@ -484,7 +490,7 @@ static void turned(int i, int code, void *ctx)
 static void settled_and_turned(int i, int code, void *ctx)
 {
     drum_batch *b = ctx;
-    for (int j = 0; j < b->n_todo; ++j)
+    for (int j = 0; j < b->n_level_todo; ++j)
         if (b->todo[j].c == b->case_todo[i]) show_run(b, b->todo[j], code, b->n_cases);
 }
 
@@ -683,9 +689,9 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
     return t->bed;
 }
 
-// The runs that start from a turned bed: the beds first, then this rank's
-// share of the runs, each a task.
-static void run_turned(drum_batch *b, const drum_run *runs, int n)
+// The runs that start from a turned bed: the beds first (kept, from the
+// store, or made now), then this rank's share of the runs as tasks.
+static void deal_turned(drum_batch *b, const drum_run *runs, int n)
 {
     prepare_turned_beds(b, runs, n);
     int rank = cal_mpi_rank(), size = cal_mpi_size();
@@ -700,16 +706,18 @@ static void run_turned(drum_batch *b, const drum_run *runs, int n)
         return;
     }
     for (int j = 0; j < m; ++j) b->turned_bed[j] = turned_bed_of(b, b->todo[b->turned_from + j], &b->turned_charge[j]);
-    if (m > 0) cal_pool_run(m, turn_from_turned, turned_from_turned, b, b->env->workers, b->env->use_fork);
+    b->n_turned_tasks = m;
 }
 
-// The runs from a level bed: dealt over the ranks, this rank's share run.
-static void run_missing_level(drum_batch *b, const drum_run *missing, int n_missing)
+// The runs from a level bed: dealt over the ranks; this rank's share as
+// tasks, on one bed settled here (every run the same fill) or a candidate each.
+static void deal_level(drum_batch *b, const drum_run *missing, int n_missing)
 {
     int rank = cal_mpi_rank(), size = cal_mpi_size();
     if (one_fill(b, missing, n_missing)) { // runs dealt one by one
         for (int i = 0; i < n_missing; ++i)
             if (i % size == rank) b->todo[b->n_todo++] = missing[i];
+        b->n_level_todo = b->n_todo;
         if (b->n_todo == 0) return;
         char err[1024];
         b->bed = settled_bed(b->env, &b->cases[b->todo[0].c].fill, &b->bed_wall_s, err, sizeof err);
@@ -717,7 +725,7 @@ static void run_missing_level(drum_batch *b, const drum_run *missing, int n_miss
             for (int i = 0; i < b->n_todo; ++i) write_failed(b->env, run_key(b, b->todo[i]), err);
             return;
         }
-        cal_pool_run(b->n_todo, turn_one, turned, b, b->env->workers, b->env->use_fork);
+        b->level_task = turn_one, b->level_done = turned, b->n_level_tasks = b->n_todo;
         return;
     }
     int n_with = 0; // candidates dealt whole: each settles its own bed
@@ -728,11 +736,27 @@ static void run_missing_level(drum_batch *b, const drum_run *missing, int n_miss
     for (int i = 0; i < n_missing; ++i)
         for (int j = 0; j < b->n_case_todo; ++j)
             if (missing[i].c == b->case_todo[j]) b->todo[b->n_todo++] = missing[i];
-    if (b->n_case_todo > 0) cal_pool_run(b->n_case_todo, settle_and_turn, settled_and_turned, b, b->env->workers, b->env->use_fork);
+    b->n_level_todo = b->n_todo;
+    b->level_task = settle_and_turn, b->level_done = settled_and_turned, b->n_level_tasks = b->n_case_todo;
 }
 
-// Deal the missing runs over the ranks and run this rank's share: those
-// from a level bed, then those from a turned one.
+// Task i of the batch: a level task, then the runs from turned beds.
+static int batch_task(int i, void *ctx)
+{
+    drum_batch *b = ctx;
+    return i < b->n_level_tasks ? b->level_task(i, ctx) : turn_from_turned(i - b->n_level_tasks, ctx);
+}
+
+static void batch_done(int i, int code, void *ctx)
+{
+    drum_batch *b = ctx;
+    if (i < b->n_level_tasks) b->level_done(i, code, ctx);
+    else turned_from_turned(i - b->n_level_tasks, code, ctx);
+}
+
+// Deal the missing runs over the ranks and run this rank's share, those
+// from a level bed and those from a turned one side by side (the beds they
+// start from are made first).
 static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missing)
 {
     drum_run *level = calloc((size_t)n_missing, sizeof *level), *turned = calloc((size_t)n_missing, sizeof *turned);
@@ -745,8 +769,10 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
         if (cal_drum_case_turned(&b->cases[missing[i].c], b->rpm[missing[i].k])) turned[n_turned++] = missing[i];
         else level[n_level++] = missing[i];
     }
-    if (n_level > 0) run_missing_level(b, level, n_level);
-    if (n_turned > 0) run_turned(b, turned, n_turned);
+    if (n_level > 0) deal_level(b, level, n_level);
+    if (n_turned > 0) deal_turned(b, turned, n_turned);
+    int tasks = b->n_level_tasks + b->n_turned_tasks;
+    if (tasks > 0) cal_pool_run(tasks, batch_task, batch_done, b, b->env->workers, b->env->use_fork);
     free(level), free(turned);
 }
 
