@@ -29,8 +29,13 @@
 #include "cal_stages.h"
 #include "exp_common.h"
 
-/// A failed or unsteady speed counts as a misfit of 5 data standard deviations
-/// (the search steers away from it without stopping).
+/// A speed without a steady measurement costs 5 data standard deviations
+/// squared (the search steers away from it without stopping). An unsteady
+/// run's mean still says how far off it is: it costs its own squared z-score
+/// plus the penalty, so it never scores better than a steady run at the same
+/// value (a flat 25 did beat real misfits where the lab's spread is small:
+/// the guide's first tiny run chose an unsteady candidate). A failed run,
+/// with no value at all, costs the penalty alone.
 static const double failed_speed_penalty = 25.0;
 /// The lab's CSA spread is floored: a quoted 0 would make one speed dominate.
 static const double min_csa_sd = 0.1;
@@ -71,11 +76,13 @@ void cal_friction_to_unit(const cal_bounds *b, double mu_s, double mu_r, double 
 }
 static const cal_bounds *bounds_of(const search *s) { return s->material ? &s->c->wall : &s->c->granule; }
 
-// A measurement's squared z-score, or the penalty where it failed.
+// A measurement's squared z-score; plus the penalty where it is not usable
+// (unsteady), the penalty alone where there is no value (failed).
 static double squared_z(double value, double target, double sd, int usable)
 {
     double z = (value - target) / sd;
-    return usable && isfinite(z) ? z * z : failed_speed_penalty;
+    if (!isfinite(z)) return failed_speed_penalty;
+    return usable ? z * z : z * z + failed_speed_penalty;
 }
 
 double cal_friction_angle_spread(const cal_friction_result *r) { return fmax(r->angle_tolerance, min_angle_sd); }
@@ -127,17 +134,21 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
 typedef struct bed_mean {
     double angle, angle_sd, csa, csa_sd;
     int n_angle, n_csa;
+    double csa_unsteady; ///< the CSA over the usable runs, steady or not (NAN: none)
 } bed_mean;
 
 static bed_mean mean_over_beds(const search *s, const cal_record *rec, int j)
 {
     bed_mean m = {0};
+    double any = 0;
     for (int b = 0; b < s->beds; ++b) {
         const cal_record *x = &rec[b * s->n_sim + j];
         if (!cal_record_usable(x)) continue;
         m.angle += x->angle_deg, m.angle_sd += x->angle_sd_deg, m.n_angle++;
+        any += x->csa_percent;
         if (x->steady) m.csa += x->csa_percent, m.csa_sd += x->csa_sd_percent, m.n_csa++;
     }
+    m.csa_unsteady = m.n_angle ? any / m.n_angle : NAN;
     m.angle = m.n_angle ? m.angle / m.n_angle : NAN, m.angle_sd = m.n_angle ? m.angle_sd / m.n_angle : NAN;
     m.csa = m.n_csa ? m.csa / m.n_csa : NAN, m.csa_sd = m.n_csa ? m.csa_sd / m.n_csa : NAN;
     return m;
@@ -153,9 +164,10 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
         int x = -1;
         for (int j = 0; j < s->n_sim; ++j)
             if (s->sim_rpm[j] == r->rpm[i]) x = j;
-        bed_mean m = x >= 0 ? mean_over_beds(s, rec, x) : (bed_mean){NAN, NAN, NAN, NAN, 0, 0};
+        bed_mean m = x >= 0 ? mean_over_beds(s, rec, x) : (bed_mean){NAN, NAN, NAN, NAN, 0, 0, NAN};
         k->usable[i] = m.n_csa > 0;
-        k->csa[i] = m.csa, k->csa_sd[i] = m.csa_sd;
+        // Not usable: the unsteady runs' mean, for its misfit (squared_z) and the report.
+        k->csa[i] = k->usable[i] ? m.csa : m.csa_unsteady, k->csa_sd[i] = m.csa_sd;
     }
     cal_candidate_score(r, k);
 }

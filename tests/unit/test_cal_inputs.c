@@ -531,11 +531,26 @@ static void test_friction_rule(void **state)
                r.angle_tolerance, cal_friction_best(&r) + 1, r.cand[cal_friction_best(&r)].objective);
         assert_int_equal(cal_friction_best(&r), expected[rule]);
     }
-    // A candidate without an angle or a speed counts as 5 standard deviations there.
+    // A candidate without an angle, or without a value at a speed (failed), counts as 5 standard
+    // deviations there; an unsteady speed with a value, as its own z² plus those 25.
     r.angle_tolerance = 2.75;
     r.cand[0].angle_deg = NAN, r.cand[0].usable[1] = 0;
     cal_candidate_score(&r, &r.cand[0]);
+    assert_true(fabs(r.cand[0].objective - (25 + 2 * 27.8 + 27.8 + 25) / 4) < 1e-9);
+    r.cand[0].csa[1] = NAN;
+    cal_candidate_score(&r, &r.cand[0]);
     assert_true(fabs(r.cand[0].objective - (25 + 2 * 27.8 + 25) / 4) < 1e-9);
+    // So an unsteady run 10 sd off no longer beats a steady one 6 sd off (a flat 25 did: 25 < 36).
+    r.angle_in_misfit = 0, r.n = 2;
+    for (int k = 0; k < 2; ++k) {
+        cal_candidate *c = &r.cand[k];
+        c->angle_deg = 42.20;
+        for (int i = 0; i < 3; ++i) c->csa[i] = 50, c->usable[i] = 1;
+    }
+    r.cand[0].csa[1] = 56, r.cand[1].csa[1] = 60, r.cand[1].usable[1] = 0;
+    for (int k = 0; k < 2; ++k) cal_candidate_score(&r, &r.cand[k]);
+    assert_true(fabs(r.cand[1].misfit - (100 + 25) / 3.0) < 1e-9);
+    assert_int_equal(cal_friction_best(&r), 0);
 }
 
 // The identified ranges (cal_friction_identify). First by hand: one speed,
@@ -566,8 +581,12 @@ static void test_identified_ranges(void **state)
     cal_range_bracket(&r.mu_s_range, 0.1, 1.0), cal_range_bracket(&r.mu_r_range, 1e-3, 0.5);
     assert_true(r.mu_s_range.bracket_lo == 0.1 && r.mu_s_range.bracket_hi == 0.7);
     assert_true(r.mu_r_range.bracket_lo == 1e-3 && r.mu_r_range.bracket_hi == 0.1);
-    // A failed speed counts as 5 spreads: C with its CSA lost is told apart.
+    // A failed speed counts as 5 spreads: C with its CSA lost is told apart; unsteady at its value,
+    // as its own 4 plus those 25.
     r.cand[2].usable[0] = 0;
+    cal_friction_identify(&r);
+    assert_true(fabs(r.cand[2].chi2 - 29) < 1e-9);
+    r.cand[2].csa[0] = NAN;
     cal_friction_identify(&r);
     assert_true(fabs(r.cand[2].chi2 - 25) < 1e-9);
 
