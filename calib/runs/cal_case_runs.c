@@ -3,6 +3,7 @@
 #include "cal_case_runs.h"
 
 #include <math.h>
+#include <omp.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -500,11 +501,17 @@ void cal_env_set_stage(cal_env *env, const char *stage)
 }
 
 
-void cal_sim_release(cal_env *env)
+// The level bed kept between candidates, let go (the turned beds stay).
+static void release_kept_bed(cal_env *env)
 {
     dem_world_destroy(env->kept_bed);
     env->kept_bed = NULL;
     env->kept_text[0] = 0;
+}
+
+void cal_sim_release(cal_env *env)
+{
+    release_kept_bed(env);
     for (int k = 0; k < env->n_turned; ++k) dem_world_destroy(env->turned[k].bed);
     free(env->turned);
     env->turned = NULL, env->n_turned = 0;
@@ -583,11 +590,14 @@ static dem_world *settled_bed(cal_env *env, const exp_drum_def *fill, double *wa
     drum_def_text(fill, text, sizeof text);
     *wall_s = 0;
     if (env->kept_bed && strcmp(text, env->kept_text) == 0) return env->kept_bed;
-    cal_sim_release(env);
+    release_kept_bed(env);
     double t0 = exp_wall_seconds();
     heartbeat h;
     heartbeat_of_bed(&h, env->stage, fill);
+    const int threads = omp_get_max_threads(); // the workers wait for this bed: their cores as threads
+    omp_set_num_threads(env->workers);
     env->kept_bed = exp_drum_fill(fill, exp_print_progress, &h.printer, err, len);
+    omp_set_num_threads(threads);
     *wall_s = exp_wall_seconds() - t0;
     if (env->kept_bed) snprintf(env->kept_text, sizeof env->kept_text, "%s", text);
     return env->kept_bed;
@@ -678,7 +688,12 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
         turned_bed_path(env, hash, path, sizeof path);
         double fill_s;
         exp_drum_result res;
+        // The workers wait for this bed: its pour and turn take their cores as threads
+        // (the parent's one thread otherwise, cal_pool.c; the result is the same on any number).
+        const int threads = omp_get_max_threads();
+        omp_set_num_threads(env->workers);
         dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
+        omp_set_num_threads(threads);
         if (!bed) return write_failed(env, run_key(b, r), err), NULL;
         // A file made by an earlier process was charged there; one made now by a worker, here.
         double turn_s = res.wall_time_s - (listed_hash(b->prepped, b->n_prep, hash) ? 0 : res.earlier_wall_s);

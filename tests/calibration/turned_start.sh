@@ -4,7 +4,8 @@
 # candidate of the stage, kept in the store as a file (<hash>.start.h5).
 #  1. The granule stage on two workers: one turned bed per seed (made side by side), every 4 rpm
 #     record names its start in its key (start=turned[...], no start tilt, MSER), the 116 rpm records
-#     do not, and each bed's cost is charged to one run only.
+#     do not, and each bed's cost is charged to one run only (the bound probes, a second batch,
+#     start from the beds the grid's batch made).
 #  2. A 4 rpm record deleted and made again on one worker, from the bed's file, has the same
 #     numbers to the last digit; so has one made after its bed's file too is deleted (the bed turned
 #     again): the file is the bed the run would have turned.
@@ -25,7 +26,7 @@ run --stage granule --jobs 2
 beds=$(ls "$store"/*.start.h5 2>/dev/null | wc -l)
 [ "$beds" -eq 2 ] || fail "granule stage: $beds turned beds in the store, want 2 (one per seed)"
 slow=$(grep -l "rpm=4 " "$store"/*.yaml) fast=$(grep -l "rpm=116 " "$store"/*.yaml)
-[ "$(echo "$slow" | wc -l)" -eq 8 ] || fail "want 8 records at 4 rpm (4 candidates x 2 beds)"
+[ "$(echo "$slow" | wc -l)" -eq 12 ] || fail "want 12 records at 4 rpm (4 grid candidates and 2 bound probes x 2 beds)"
 for f in $slow; do
   k=$(grep '^key:' "$f")
   for want in 'start=turned\[time=1 tilt=20 granule\[k=200,200,200 xi=0.7 mu=0.5,0.1 ' 'start_tilt=0 ' 'steady=mser se=3,1'; do
@@ -34,7 +35,7 @@ for f in $slow; do
 done
 for f in $fast; do grep -q 'start=turned' "$f" && fail "$f: a 116 rpm run started turned"; done
 charged=$(for f in $slow; do grep '^fill_wall_time_s:' "$f"; done | awk '$2 > 0' | wc -l)
-[ "$charged" -eq 2 ] || fail "$charged of the 4 rpm records carry a turned bed's cost, want 2 (one per bed)"
+[ "$charged" -eq 2 ] || fail "$charged of the 4 rpm records carry a turned bed's cost, want 2 (one per bed, the probes' batch from the same beds)"
 
 # 2. Made again: from the bed's file, then with the bed turned again.
 victim=$(echo "$slow" | head -1)
@@ -55,4 +56,16 @@ after=$(ls "$store"/*.start.h5 | wc -l)
 [ $((after - before)) -eq 2 ] || fail "the wall stage made $((after - before)) turned beds, want 2"
 walls=$(grep -l "rpm=4 .*start=turned" "$store"/*.yaml | xargs grep -l 'wall\[k=400' || true)
 [ -n "$walls" ] || fail "no wall-stage 4 rpm record started turned"
+# 4. One bed per candidate and COBYLA's steps: a batch of one candidate shares its fill, which the
+#    parent settles (a new one each candidate) while the turned bed stays kept for the next batch:
+#    made and charged once (a build that let it go with the level bed charged it twice).
+sed -e 's|\.\./experiments/data/|'"$src"'/experiments/data/|' \
+    -e '/name: check-turned/,/name: standard/ { s/    beds: 2/    beds: 1/; s/    max_evaluations: 0/    max_evaluations: 2/ }' \
+  "$src/configs/calibration.yaml" > "$work/one_bed.yaml"
+"$bin" calibrate "$work/one_bed.yaml" --tier check-turned --out "$work/one" --stage granule --jobs 2 2>> "$work/log"
+one=$(grep -l "rpm=4 " "$work/one/store"/*.yaml)
+[ "$(echo "$one" | wc -l)" -ge 7 ] || fail "one bed: want at least 7 records at 4 rpm (6 candidates and a COBYLA step)"
+[ "$(ls "$work/one/store"/*.start.h5 | wc -l)" -eq 1 ] || fail "one bed: want one turned bed"
+charged=$(for f in $one; do grep '^fill_wall_time_s:' "$f"; done | awk '$2 > 0' | wc -l)
+[ "$charged" -eq 1 ] || fail "one bed: $charged of its 4 rpm records carry the turned bed's cost, want 1"
 echo "ok: one turned bed per seed and stage, keys name it, its cost charged once, a run from its file or from it turned again is the same to the last digit"
