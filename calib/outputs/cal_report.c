@@ -591,6 +591,23 @@ static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
           "systems spend about 80 (GrainLearning) to 480 (ACCES) simulations per calibration.\n", f);
 }
 
+// How the tier's runs start and stop, where a speed starts turned (the
+// reader of the angle must know it was not a level bed's first seconds).
+static void report_run_starts(FILE *f, const cal_outcome *o)
+{
+    const cal_tier *t = o->tier;
+    if (t->turned_start_rpm_count == 0) return;
+    fputs("Runs: ", f);
+    for (unsigned k = 0; k < t->turned_start_rpm_count; ++k) fprintf(f, "%s%g", k ? ", " : "", t->turned_start_rpm[k]);
+    fprintf(f, " rpm from the stage's bed turned %g s at that speed first (stage 2: poured and turned at the pour's "
+               "prior pair μs = %g, μr = %g; stage 3: at the frozen granule pair, lined with granules), going on with "
+               "the candidate's pair, MSER cutting the change and stopping at a standard error of %g° and %g points "
+               "(or at %g s, not steady); the other speeds from the level bed tilted by the start tilt, the windows' "
+               "test, then their averaging time.\n\n",
+            t->turned_start_time, o->config->pour_mu_s, o->config->pour_mu_r, t->steady_se_angle_deg,
+            t->steady_se_csa_percent, t->max_time);
+}
+
 static int write_report(const char *dir, const cal_outcome *o, const posteriors *post, const sim_tally *tally,
                         char *err, size_t len)
 {
@@ -606,6 +623,7 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
             rs.demonstration ? "demonstration (not a calibration of this powder)" : "calibration", o->command,
             o->config->path, t->name, t->lambda, t->slice_depth > 0 ? "periodic slice" : "full drum", t->max_time,
             t->window, t->cylinder_lambda, exp_version(), cal_build_commit(), o->ranks, o->workers, o->wall_time_s);
+    report_run_starts(f, o);
     cal_run_status_banner(f, &rs, "> ");
     fputs("\nValues the data did not choose (each row's status in `calibrated_parameters.csv`):\n\n", f);
     long before = ftell(f);

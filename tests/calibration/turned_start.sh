@@ -34,6 +34,8 @@ for f in $slow; do
   done
 done
 for f in $fast; do grep -q 'start=turned' "$f" && fail "$f: a 116 rpm run started turned"; done
+grep -q "^Runs: 4 rpm from the stage's bed turned 1 s at that speed first" "$work/out/report.md" ||
+  fail "report.md does not say how the 4 rpm runs start"
 charged=$(for f in $slow; do grep '^fill_wall_time_s:' "$f"; done | awk '$2 > 0' | wc -l)
 [ "$charged" -eq 2 ] || fail "$charged of the 4 rpm records carry a turned bed's cost, want 2 (one per bed, the probes' batch from the same beds)"
 
