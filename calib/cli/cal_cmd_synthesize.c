@@ -342,11 +342,17 @@ static void print_plan(const job *j)
     int parallel = j->opt.jobs * cal_mpi_size();
     cal_plan total = {{0}, {0}};
     fprintf(stderr, "== plan: synthesize at tier '%s', %d worker(s); expected (worst case)\n", j->t->name, parallel);
+    int wall_beds_made = 0; // the wall linings start from one set of turned beds (the frozen pair's)
     for (int l = 0; l < j->n_linings; ++l) {
         cal_plan p = {{0}, {0}};
         cal_drum_case d = case_of(j, &j->linings[l], j->opt.seeds[0]);
-        for (int w = 0; w < 2; ++w)
-            cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, j->rpm, j->n_rpm, j->opt.n_seeds, 1, 0, 0, parallel, w);
+        const int turned_beds_here = !j->linings[l].wall || !wall_beds_made;
+        wall_beds_made |= j->linings[l].wall != NULL;
+        for (int w = 0; w < 2; ++w) {
+            cal_plan_cost *cost = w ? &p.worst : &p.expected;
+            if (turned_beds_here) cal_plan_turned_beds(cost, &d, j->opt.n_seeds, parallel);
+            cal_plan_drum_batch(cost, &d, j->rpm, j->n_rpm, j->opt.n_seeds, 1, 0, 0, parallel, w);
+        }
         fprintf(stderr, "   %-20s %4d drum runs %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", j->linings[l].surface,
                 p.expected.runs, p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600,
                 p.worst.wall_s / 3600);
