@@ -535,7 +535,8 @@ static void turned_bed_path(const cal_env *env, const char *hash, char *out, siz
 // Case c's start bed poured and turned at `rpm`, resumed from (and saved to)
 // its file in the store: once turned, a later process pours it again (a
 // pour's cost) and takes the turn from the file. NULL with a message if it
-// failed. *turn_s: the wall time of the turn, with what came before its file.
+// failed. *fill_s: the pour's wall time; res->wall_time_s the turn's, with
+// what came before its file (res->earlier_wall_s).
 static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, double rpm, double *fill_s,
                                   exp_drum_result *res, char *err, size_t len)
 {
@@ -641,7 +642,8 @@ static int listed_hash(char (*hashes)[17], int n, const char *hash)
 // The turned beds of runs[0..n) that this process does not keep and the
 // store has no file of, made side by side when there are several (by rank
 // 0: every rank then takes them from the store). Their hashes in
-// b->prepped: made now, so their whole turn is this process's cost.
+// b->prepped: made now, so their whole turn is this process's cost (rank
+// 0's: another rank charges only its own pour of such a bed).
 static void prepare_turned_beds(drum_batch *b, const drum_run *runs, int n)
 {
     b->prep = calloc((size_t)n, sizeof *b->prep);
@@ -655,9 +657,10 @@ static void prepare_turned_beds(drum_batch *b, const drum_run *runs, int n)
         snprintf(todo[b->n_prep], sizeof todo[0], "%s", hash);
         b->prep[b->n_prep++] = runs[i];
     }
-    // One bed alone is made by the process that keeps it (run_turned), without a second pour;
+    // One bed alone is made by the process that keeps it (turned_bed_of), without a second pour;
     // so is every bed where no file is kept (--checkpoint-every 0).
-    if (b->n_prep > 1 && b->env->checkpoint_every_s > 0) cal_pool_run(b->n_prep, prepare_turned, prepared, b, b->env->workers, b->env->use_fork);
+    if (b->n_prep > 1 && b->env->checkpoint_every_s > 0)
+        cal_pool_run(b->n_prep, prepare_turned, prepared, b, b->env->workers, b->env->use_fork);
     else b->n_prep = 0;
     cal_mpi_barrier(); // the files are on the shared store now
 }
