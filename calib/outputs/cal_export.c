@@ -339,6 +339,20 @@ static void deck_steps_text(FILE *f, const char *pour)
             pour);
 }
 
+// Where the tier started some speeds from a turned bed, the deck (which turns
+// from the level bed) says so, and what that asks of spinup.
+static void deck_turned_text(FILE *f, const cal_outcome *o)
+{
+    const cal_tier *t = o->tier;
+    if (t->turned_start_rpm_count == 0) return;
+    fprintf(f, "# Not as granucal ran it at ");
+    for (unsigned k = 0; k < t->turned_start_rpm_count; ++k) fprintf(f, "%s%g", k ? ", " : "", t->turned_start_rpm[k]);
+    fprintf(f, " rpm: there each run went on from a bed already turned %g s at that speed (turned_start_rpm), and MSER\n"
+               "# cut its transient. From a level bed a 4 rpm bed at lambda 1000 compacts for ~8 s, its angle ~1.4 deg high\n"
+               "# meanwhile (results/steady_rule/turned_start/): give spinup at least that much there.\n",
+            t->turned_start_time);
+}
+
 // The variables a user may set (-var NAME VALUE keeps its value: an index
 // variable already defined is not redefined) and those derived from them.
 static void deck_variables(FILE *f, const cal_outcome *o, const deck_scene *s, const char *dump)
@@ -541,6 +555,7 @@ static int write_deck(const char *dir, const cal_outcome *o, const deck_scene *s
     deck_scene_text(f, o, s);
     deck_step_text(f, s);
     deck_steps_text(f, lattice_pour_text);
+    deck_turned_text(f, o);
     if (c->before_variables) c->before_variables(f, s);
     deck_variables(f, o, s, c->dump_file);
     c->setup(f, o, s);

@@ -58,6 +58,9 @@ after=$(ls "$store"/*.start.h5 | wc -l)
 [ $((after - before)) -eq 2 ] || fail "the wall stage made $((after - before)) turned beds, want 2"
 walls=$(grep -l "rpm=4 .*start=turned" "$store"/*.yaml | xargs grep -l 'wall\[k=400' || true)
 [ -n "$walls" ] || fail "no wall-stage 4 rpm record started turned"
+for deck in liggghts_drum.in lammps_drum.in; do
+  grep -q "^# Not as granucal ran it at 4 rpm" "$work/out/$deck" || fail "$deck does not say its 4 rpm start differs"
+done
 # 4. One bed per candidate and COBYLA's steps: a batch of one candidate shares its fill, which the
 #    parent settles (a new one each candidate) while the turned bed stays kept for the next batch:
 #    made and charged once (a build that let it go with the level bed charged it twice).
