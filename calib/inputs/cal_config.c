@@ -414,13 +414,6 @@ double cal_tier_average_time(const cal_tier *t, double rpm)
     return t->average_time;
 }
 
-int cal_tier_turned_start(const cal_tier *t, double rpm)
-{
-    for (unsigned k = 0; k < t->turned_start_rpm_count; ++k)
-        if (t->turned_start_rpm[k] == rpm) return 1;
-    return 0;
-}
-
 static int check_fidelity(const cal_config *c, char *err, size_t len)
 {
     const cal_fidelity *f = c->fidelity;

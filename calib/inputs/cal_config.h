@@ -141,8 +141,6 @@ double cal_tier_csa_sd(const cal_tier *t, unsigned i);
 /// Seconds a run at `rpm` averages after its steady test: average_time_per_rpm's
 /// entry for that speed, else average_time.
 double cal_tier_average_time(const cal_tier *t, double rpm);
-/// 1 if the tier's runs at `rpm` start from a turned bed (turned_start_rpm).
-int cal_tier_turned_start(const cal_tier *t, double rpm);
 
 /// The first key of a calibration tier alone that t gives (a value other
 /// than 0 or absent), NULL if none: a rung of the fidelity study may not.

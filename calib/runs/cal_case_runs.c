@@ -363,6 +363,18 @@ static void heartbeat_of_bed(heartbeat *h, const char *stage, const exp_drum_def
     heartbeat_start(h, stage, what);
 }
 
+// A bed of `fill` poured and settled, with a heartbeat in the log; *wall_s:
+// what it took. NULL with a message if the fill failed.
+static dem_world *pour_bed(const cal_env *env, const exp_drum_def *fill, double *wall_s, char *err, size_t len)
+{
+    double t0 = exp_wall_seconds();
+    heartbeat h;
+    heartbeat_of_bed(&h, env->stage, fill);
+    dem_world *bed = exp_drum_fill(fill, exp_print_progress, &h.printer, err, len);
+    *wall_s = exp_wall_seconds() - t0;
+    return bed;
+}
+
 // A run stored by a task that goes on turning the same bed at other speeds:
 // said at once, since the task's own line (with the progress) comes only when
 // the bed's last speed is done.
@@ -430,11 +442,8 @@ static int settle_and_turn(int i, void *ctx)
     drum_batch *b = ctx;
     int c = b->case_todo[i], bad = 0;
     char err[1024];
-    double t0 = exp_wall_seconds();
-    heartbeat h;
-    heartbeat_of_bed(&h, b->env->stage, &b->cases[c].fill);
-    dem_world *bed = exp_drum_fill(&b->cases[c].fill, exp_print_progress, &h.printer, err, sizeof err);
-    double fill_s = exp_wall_seconds() - t0;
+    double fill_s;
+    dem_world *bed = pour_bed(b->env, &b->cases[c].fill, &fill_s, err, sizeof err);
     int left = 0;
     for (int j = 0; j < b->n_level_todo; ++j) left += b->todo[j].c == c;
     for (int j = 0; j < b->n_level_todo; ++j) {
@@ -542,14 +551,11 @@ static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, do
     char key[2048], hash[17], path[1300], what[64], prefix[80];
     turned_bed_hash(c, rpm, key, sizeof key, hash);
     turned_bed_path(env, hash, path, sizeof path);
-    double t0 = exp_wall_seconds();
-    heartbeat h;
-    heartbeat_of_bed(&h, env->stage, &c->start);
-    dem_world *bed = exp_drum_fill(&c->start, exp_print_progress, &h.printer, err, len);
-    *fill_s = exp_wall_seconds() - t0;
+    dem_world *bed = pour_bed(env, &c->start, fill_s, err, len);
     if (!bed) return NULL;
     snprintf(what, sizeof what, "the turned bed of seed %llu, %g rpm", (unsigned long long)c->start.seed, rpm);
     snprintf(prefix, sizeof prefix, "[%s]", env->stage);
+    heartbeat h;
     heartbeat_start(&h, env->stage, what);
     exp_drum_turn turn = {.def = &c->start, .run = start_turn_opts(c, rpm), .checkpoint_path = path, .key = key,
                           .checkpoint_every_s = env->checkpoint_every_s, .checkpoint_at_end = 1,
@@ -591,11 +597,7 @@ static dem_world *settled_bed(cal_env *env, const exp_drum_def *fill, double *wa
     *wall_s = 0;
     if (env->kept_bed && strcmp(text, env->kept_text) == 0) return env->kept_bed;
     release_kept_bed(env);
-    double t0 = exp_wall_seconds();
-    heartbeat h;
-    heartbeat_of_bed(&h, env->stage, fill);
-    env->kept_bed = exp_drum_fill(fill, exp_print_progress, &h.printer, err, len);
-    *wall_s = exp_wall_seconds() - t0;
+    env->kept_bed = pour_bed(env, fill, wall_s, err, len);
     if (env->kept_bed) snprintf(env->kept_text, sizeof env->kept_text, "%s", text);
     return env->kept_bed;
 }
@@ -680,11 +682,10 @@ static void turned_from_turned(int i, int code, void *ctx)
 static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
 {
     cal_env *env = b->env;
-    char key[2048], hash[17], path[1300], err[1024];
+    char key[2048], hash[17], err[1024];
     turned_bed_hash(&b->cases[r.c], b->rpm[r.k], key, sizeof key, hash);
     struct cal_turned_bed *t = kept_turned(env, hash);
     if (!t) {
-        turned_bed_path(env, hash, path, sizeof path);
         double fill_s;
         exp_drum_result res;
         // On the parent's one thread (cal_pool.c): given the idle workers' cores as OpenMP threads, a

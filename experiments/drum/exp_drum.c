@@ -467,6 +467,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     dem_status st = out->resumed ? DEM_OK : start_turn(w, d, o, &s, out);
     if (st != DEM_OK) return free(s.m), free(scratch), st;
     out->earlier_wall_s = s.earlier_wall_s;
+    const uint64_t steps_before = s.steps; // a resumed turn already done steps none here
     const double check_wall_before = dem_world_network_checks(w).wall_s;
     double pixel = face_pixel(d), started = exp_wall_seconds(), saved = started;
     while (s.count < s.cap && dem_world_time(w) - s.t0 < o->max_time - 0.5 * o->sample_interval &&
@@ -505,7 +506,7 @@ dem_status exp_drum_rotate(dem_world *w, const exp_drum_def *d, const exp_drum_r
     // them (average_time); under the MSER rule, every sample from its start.
     // Not steady: the last two windows.
     report_checks(w, check_wall_before, out);
-    if (o->checkpoint && o->checkpoint->at_end && st == DEM_OK &&
+    if (o->checkpoint && o->checkpoint->at_end && st == DEM_OK && s.steps != steps_before &&
         save_turn(w, o, &s, out, exp_wall_seconds() - started, out->checkpoint_note, sizeof out->checkpoint_note) == 0)
         out->checkpoint_note[0] = '\0';
     out->steady = s.steady_from >= 0;

@@ -130,7 +130,8 @@ typedef struct exp_drum_checkpoint {
     const char *key;  ///< the text that defines the run: another run's checkpoint is not resumed
     double every_s;   ///< wall seconds between saves, each at the end of a sample
     /// 1: save once more when the run ends, so that the file holds the turned
-    /// bed itself (a bed other runs start from; resumed, the run is done).
+    /// bed itself (a bed other runs start from; resumed, the run is done, and
+    /// the file is not written again).
     int at_end;
 } exp_drum_checkpoint;
 

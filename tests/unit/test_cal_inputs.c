@@ -175,8 +175,8 @@ static void test_shipped_config_loads(void **state)
     // level and are averaged 2 s
     assert_true(cal_tier_average_time(standard, 4) == 0 && cal_tier_average_time(standard, 40) == 2 &&
                 cal_tier_average_time(standard, 116) == 2);
-    assert_true(cal_tier_turned_start(standard, 4) && !cal_tier_turned_start(standard, 40) &&
-                !cal_tier_turned_start(standard, 116));
+    assert_int_equal(standard->turned_start_rpm_count, 1); // 4 rpm alone: not 40 or 116
+    assert_true(standard->turned_start_rpm[0] == 4);
     assert_true(standard->turned_start_time == 10 && cal_tier_stiffness_on_drum(standard));
     cal_config_free(c);
     // fine-levels: three levels, lambda 512 on the standard tier's stage, itself on ci's
