@@ -690,7 +690,8 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
         exp_drum_result res;
         // On the parent's one thread (cal_pool.c): given the idle workers' cores as OpenMP threads, a
         // λ 1000 bed turned at 241 s of wall a simulated second on this 2-core machine, where one thread
-        // a run takes 95-128 (results/calibration-standard-kriging/ records at the same k_n).
+        // a run took 91-179 (median ~110; the 12 λ 1000 4 rpm records of
+        // results/calibration-standard-kriging/, same k_n, two runs side by side).
         dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
         if (!bed) return write_failed(env, run_key(b, r), err), NULL;
         // A file made by an earlier process was charged there; one made now by a worker, here.
