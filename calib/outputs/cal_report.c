@@ -678,16 +678,33 @@ static int write_figures(const char *dir, const cal_outcome *o, const posteriors
     return 0;
 }
 
-int cal_report_write(const char *dir, const cal_outcome *o, char *err, size_t len)
+// The outcome with each friction's credible interval from its stage's
+// posterior, so that every output judges a value against it alike.
+static cal_outcome with_credible(const cal_outcome *o, const posteriors *post)
 {
+    cal_outcome judged = *o;
+    memset(judged.credible, 0, sizeof judged.credible);
+    for (int i = 0; i < n_stages(o); ++i) {
+        if (!post->ok[i]) continue;
+        const cal_posterior *q = &post->of[i];
+        for (int k = 0; k < 2; ++k)
+            judged.credible[i][k] = (cal_credible){1, q->lo[k], q->hi[k], q->reaches_lower[k], q->reaches_upper[k]};
+    }
+    return judged;
+}
+
+int cal_report_write(const char *dir, const cal_outcome *outcome, char *err, size_t len)
+{
+    posteriors *post = malloc(sizeof *post);
+    if (!post) return exp_fail(err, len, "out of memory");
+    posteriors_sample(outcome, post);
+    cal_outcome judged = with_credible(outcome, post);
+    const cal_outcome *o = &judged;
     cal_table_row rows[CAL_TABLE_MAX_ROWS];
     int n = cal_table_rows(o, rows);
     char store[1100];
     snprintf(store, sizeof store, "%s/store", dir);
     sim_tally tally = {0};
-    posteriors *post = malloc(sizeof *post);
-    if (!post) return exp_fail(err, len, "out of memory");
-    posteriors_sample(o, post);
     int bad = write_table_csv(dir, o, post, rows, n, err, len) || write_table_md(dir, o, post, rows, n, err, len) ||
               write_table_h5(dir, o, rows, n, err, len) || cal_export_write(dir, o, err, len) ||
               write_simulations(dir, store, o, &tally, err, len) || write_report(dir, o, post, &tally, err, len);

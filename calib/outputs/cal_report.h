@@ -39,6 +39,11 @@ typedef struct cal_outcome {
     const char *command;
     double wall_time_s;
     int ranks, workers;
+    /// [stage][0: μs, 1: μr], stage 0 the granule stage, 1 + w wall w: each
+    /// friction's credible interval, which its status is judged against
+    /// (cal_table_rows). cal_report_write fills it from the posteriors it
+    /// samples; the caller leaves it zero.
+    cal_credible credible[17][2];
 } cal_outcome;
 
 /// Write every output into dir. 0 on success, else 1 with a message.

@@ -61,6 +61,16 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
     return v;
 }
 
+void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
+{
+    if (!c || !c->known || v->status == CAL_VALUE_NOT_RUN || !outside(value, c->lo, c->hi)) return;
+    // Beyond an end that runs to its search bound, the value lies between that end and the bound: the
+    // posterior does not hold it off (its 2.5 % and 97.5 % points sit inside the bounds by construction).
+    if ((value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower)) return;
+    add_flag(v, "outside_credible");
+    v->status = CAL_VALUE_NOT_A_RESULT, v->side = 0;
+}
+
 const char *cal_value_status_name(cal_value_status s)
 {
     static const char *const names[] = {"input", "derived", "calibrated", "one-sided", "not identified", "not a result",
@@ -90,10 +100,12 @@ static cal_table_row plain_row(const char *contact, const char *parameter, doubl
 }
 
 static cal_table_row friction_row(const char *contact, const char *material, const char *parameter, double value,
-                                  cal_range g, double bound_lo, double bound_hi, int angle_matched)
+                                  cal_range g, double bound_lo, double bound_hi, int angle_matched,
+                                  const cal_credible *credible)
 {
     cal_table_row r = {contact, "", parameter, value, "-", g,
                        cal_verdict_friction(value, g, bound_lo, bound_hi, angle_matched)};
+    cal_verdict_credible(&r.verdict, value, credible);
     snprintf(r.material, sizeof r.material, "%s", material);
     return r;
 }
@@ -121,16 +133,19 @@ int cal_table_rows(const cal_outcome *o, cal_table_row *rows)
     rows[n++] = plain_row(gg, "density", t->density, "kg/m3", CAL_VALUE_INPUT);
     for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gg, k_names[k], t->k_n);
     rows[n++] = plain_row(gg, "xi", t->xi, "-", CAL_VALUE_INPUT);
-    rows[n++] = friction_row(gg, "", "mu_s", t->gg_mu_s, t->gg_mu_s_range, gb->mu_s_min, gb->mu_s_max, t->gg_angle_matched);
-    rows[n++] = friction_row(gg, "", "mu_r", t->gg_mu_r, t->gg_mu_r_range, gb->mu_r_min, gb->mu_r_max, t->gg_angle_matched);
+    const cal_credible(*cr)[2] = o->credible;
+    rows[n++] = friction_row(gg, "", "mu_s", t->gg_mu_s, t->gg_mu_s_range, gb->mu_s_min, gb->mu_s_max,
+                             t->gg_angle_matched, &cr[0][0]);
+    rows[n++] = friction_row(gg, "", "mu_r", t->gg_mu_r, t->gg_mu_r_range, gb->mu_r_min, gb->mu_r_max,
+                             t->gg_angle_matched, &cr[0][1]);
     for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gw, k_names[k], exp_boundary_stiffness(t->k_n));
     rows[n++] = plain_row(gw, "xi", t->xi, "-", CAL_VALUE_INPUT);
     for (int w = 0; w < t->n_walls && n + 2 <= CAL_TABLE_MAX_ROWS; ++w) {
         int matched = t->wall_angle_matched[w];
         rows[n++] = friction_row(gw, t->wall_name[w], "mu_s", t->wall_mu_s[w], t->wall_mu_s_range[w], wb->mu_s_min,
-                                 wb->mu_s_max, matched);
+                                 wb->mu_s_max, matched, &cr[1 + w][0]);
         rows[n++] = friction_row(gw, t->wall_name[w], "mu_r", t->wall_mu_r[w], t->wall_mu_r_range[w], wb->mu_r_min,
-                                 wb->mu_r_max, matched);
+                                 wb->mu_r_max, matched, &cr[1 + w][1]);
     }
     return n;
 }
@@ -174,8 +189,8 @@ void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix)
             s->csa_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab");
     fprintf(f, "%sEach value's status: calibrated (chosen by the data), one-sided (a search bound the data do not "
                "close: >= or <=), not identified (the data exclude nothing in the search range), not a result (the "
-               "search's choice lies outside the interval its own data leave), stage not run (the config's value), "
-               "input, derived.\n", prefix);
+               "search's choice lies outside the interval its own data leave, or outside its posterior's 95 %% "
+               "credible interval), stage not run (the config's value), input, derived.\n", prefix);
 }
 
 void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)

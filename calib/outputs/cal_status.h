@@ -35,8 +35,9 @@ typedef struct cal_verdict {
     double known;     ///< one-sided: what the data do say, "≥ known" (side +1) or "≤ known" (side -1): the
                       ///< other end of the interval no candidate excludes (the value itself if none)
     char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, outside_identified,
-                      ///< outside_not_excluded, not_identified, angle_not_matched, stage_not_run,
-                      ///< stiffness_at_cylinder_lambda (stage 1 swept a cylinder at another λ than the drum's)
+                      ///< outside_not_excluded, outside_credible, not_identified, angle_not_matched,
+                      ///< stage_not_run, stiffness_at_cylinder_lambda (stage 1 swept a cylinder at another λ
+                      ///< than the drum's)
 } cal_verdict;
 
 /// A friction's verdict from its identified range g (cal_range; NAN lo: the
@@ -44,6 +45,12 @@ typedef struct cal_verdict {
 /// pair matched the angle (1, 0, or -1 unknown: the stage was read from an
 /// earlier run's stage file).
 cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched);
+
+/// Judge v against the friction's credible interval c: a value outside it is
+/// not a result (flag outside_credible), except beyond an end that runs to
+/// its search bound (a value on that bound: the posterior's 97.5 % point
+/// sits below the upper bound by construction).
+void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);

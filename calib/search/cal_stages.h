@@ -83,6 +83,15 @@ typedef struct cal_range {
 /// Set g's bracket from below/above and the search bounds.
 void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi);
 
+/// A friction's 95 % credible interval from its stage's posterior
+/// (cal_posterior.h); known 0 where there is none (a stage read from an
+/// earlier run's stage file, or too few runs to map).
+typedef struct cal_credible {
+    int known;
+    double lo, hi;
+    int reaches_lower, reaches_upper; ///< the interval runs to that search bound
+} cal_credible;
+
 /// One tier below a two-tier stage's own (its map tier, or a level further
 /// down where the map tier maps with another): what it ran, what it cost and
 /// what its own search chose, so that a report shows what each level bought.

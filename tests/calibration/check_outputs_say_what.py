@@ -4,14 +4,16 @@
 #   check_outputs_say_what.py RUN_DIR --tier T --purpose calibration|demonstration --data "angle lab / CSA synthetic"
 # - calibrated_parameters.csv: every row carries tier, lambda, data and purpose as given, and a status;
 #   every friction row's status follows from its own numbers (value, identified range, not-excluded
-#   interval, the search bounds read from the run's config.yaml): a value on a bound is never
-#   'calibrated', a value outside its own interval is 'not a result';
+#   interval, the posterior's 95 % credible interval, the search bounds read from the run's config.yaml):
+#   a value on a bound is never 'calibrated', a value outside its own interval is 'not a result', and so is
+#   one outside its credible interval unless beyond an end that runs to within 3 % of the search range
+#   (μs linear, μr in log10) of its bound;
 # - calibrated_parameters.md, report.md, liggghts_parameters.in, lammps_parameters.in: the banner
 #   (DEMONSTRATION or CALIBRATION, the tier, the data's provenance); the two .in files list every
 #   friction the data did not choose (and the stiffness where stage 1 did not choose it) on a
 #   'NOT CALIBRATED:' line, and no other.
 # Exit 1 on any failure, naming it.
-import csv, sys
+import csv, math, sys
 
 import yaml  # python3-yaml (.ci/setup)
 
@@ -25,6 +27,20 @@ def bounds(run_dir):
     return {(block, k): float(v) for block in ('granule', 'wall') for k, v in config[block].items()}
 
 
+def outside_credible(r, v, lo_bound, hi_bound, outside):
+    """Outside the posterior's 95 % credible interval, and not beyond an end that reaches its bound."""
+    if r.get('credible_min', '') == '':
+        return False
+    clo, chi = float(r['credible_min']), float(r['credible_max'])
+    unit = (lambda x: math.log10(x)) if r['parameter'] == 'mu_r' else (lambda x: x)
+    span = unit(hi_bound) - unit(lo_bound)
+    reaches_lower = (unit(clo) - unit(lo_bound)) / span <= 0.03 + 1e-6
+    reaches_upper = (unit(hi_bound) - unit(chi)) / span <= 0.03 + 1e-6
+    if not outside(clo, chi):
+        return False
+    return not ((v > chi and reaches_upper) or (v < clo and reaches_lower))
+
+
 def expected_status(r, lo_bound, hi_bound):
     if r['identified_min'] == '':
         return 'stage not run'
@@ -34,7 +50,7 @@ def expected_status(r, lo_bound, hi_bound):
     slack = 1e-6
     outside = lambda a, b: v < a * (1 - slack) or v > b * (1 + slack)
     near = lambda a, b: abs(a - b) <= 1e-9 * abs(b)
-    if outside(lo, hi) or outside(blo, bhi):
+    if outside(lo, hi) or outside(blo, bhi) or outside_credible(r, v, lo_bound, hi_bound, outside):
         return 'not a result'
     if near(blo, lo_bound) and near(bhi, hi_bound):
         return 'not identified'

@@ -77,6 +77,40 @@ static void test_nothing_excluded_is_not_identified(void **state)
     assert_string_equal(cal_verdict_value_text(text, sizeof text, 1e-5, &v), "not identified");
 }
 
+static void test_outside_its_credible_interval_is_not_a_result(void **state)
+{
+    (void)state;
+    // A value the Δχ² cut keeps (identified at itself, not excluded 1.5e-4 - 0.5) but the posterior puts
+    // outside its 95 % credible interval 1.2e-5 - 0.02: not a result, whatever the runs' cut says.
+    cal_verdict v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0};
+    cal_verdict_credible(&v, 0.0334, &narrow);
+    assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
+    assert_string_equal(v.flags, "outside_credible");
+    // Inside it, or with no posterior (a stage read from a stage file), nothing changes.
+    v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
+    cal_credible wide = {1, 1.2e-5, 0.2, 1, 0}, none = {0};
+    cal_verdict_credible(&v, 0.0334, &wide);
+    cal_verdict_credible(&v, 0.0334, &none);
+    cal_verdict_credible(&v, 0.0334, NULL);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    assert_string_equal(v.flags, "");
+    // The standard run's granule μs on its upper bound 1.0, credible 0.663 - 0.996 running to that bound: the
+    // 97.5 % point of a posterior sits below the bound by construction, so it stays one-sided.
+    v = cal_verdict_friction(1.0, range(1.0, 1.0, 0.775, 1.0), 0.1, 1.0, 1);
+    cal_credible to_upper = {1, 0.662998, 0.995937, 0, 1};
+    cal_verdict_credible(&v, 1.0, &to_upper);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_string_equal(v.flags, "at_upper_bound");
+    // The same bound with a posterior held off it (credible 0.3 - 0.7): the data say the bound is wrong.
+    cal_credible held_off = {1, 0.3, 0.7, 0, 0};
+    cal_verdict_credible(&v, 1.0, &held_off);
+    assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
+    assert_int_equal(v.side, 0);
+    assert_string_equal(v.flags, "at_upper_bound;outside_credible");
+}
+
 static void test_a_stage_not_run_is_not_calibrated(void **state)
 {
     (void)state;
@@ -93,6 +127,7 @@ int main(void)
         cmocka_unit_test(test_a_bound_is_one_sided),
         cmocka_unit_test(test_outside_its_own_interval_is_not_a_result),
         cmocka_unit_test(test_nothing_excluded_is_not_identified),
+        cmocka_unit_test(test_outside_its_credible_interval_is_not_a_result),
         cmocka_unit_test(test_a_stage_not_run_is_not_calibrated),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
