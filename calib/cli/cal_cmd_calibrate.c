@@ -449,7 +449,9 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 //  - the wall stages of one tier share their grid: the same pairs on the same
 //    bed (the granule pair frozen), run for the first material, found in the
 //    store by the others;
-//  - a two-tier stage runs all its max_evaluations at its own tier: it stops
+//  - a two-tier stage runs all its max_evaluations at its own tier, and none of
+//    its posterior_runs (those only where the posterior asks; the worst case
+//    counts them): it stops
 //    earlier only when a run agrees with the corrected map within the data's
 //    noise, or the map's optimum returns to a point already run, and with
 //    the standard tier's small noise that is the exception (the committed
@@ -587,7 +589,8 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
         *turned_made = 1;
     }
     if (deciding) {
-        for (int i = 0; i < t->max_evaluations; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
+        int runs = t->max_evaluations + (pass->worst ? t->posterior_runs : 0); // the posterior's only where it asks
+        for (int i = 0; i < runs; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
         return 0;
     }
     int *grid_run = &pass->wall_grid_run[tier_slot(r, t)];
@@ -665,8 +668,8 @@ static void print_plan(const run *r, const plan *p)
             p->total.expected.runs, e, p->total.worst.runs, w, fmax(p->total.expected.memory_mb, p->total.worst.memory_mb));
     fprintf(stderr, "   expected: each drum run ends at the steady test's first chance (two windows, then its averaging), "
                     "a search's COBYLA starts at the grid's best (run already), the wall stages share one grid, a "
-                    "two-tier stage runs all its max_evaluations; k_n %g N/m, %s. Worst case: max_time every run, every "
-                    "candidate new, k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
+                    "two-tier stage runs all its max_evaluations and none of its posterior_runs; k_n %g N/m, %s. Worst "
+                    "case: max_time every run, every candidate new (posterior_runs too), k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
                     "records already in %s/store are not subtracted.\n",
             p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
 }

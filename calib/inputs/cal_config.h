@@ -113,6 +113,11 @@ typedef struct cal_tier {
     /// How the discrepancy measured at this tier's runs corrects the map
     /// (cal_mf_correction_kind; absent: kriging).
     int *map_correction;
+    /// With a map_tier: after the loop, at most this many more runs, each
+    /// where the posterior on the corrected map is still held wide by the
+    /// map's own uncertainty (cal_posterior_next_run); none where its width
+    /// is the data's. Absent: 0.
+    int posterior_runs;
     /// Beds each drum candidate is run on (seeds seed, seed+1, ...), its
     /// measurements the mean over them. angle_sd_deg and csa_sd_percent stay
     /// one bed's spreads, as measured; the search divides them by sqrt(beds)

@@ -266,26 +266,51 @@ static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const c
     if (p->correction == CAL_MF_KRIGING && m >= 2) krige_residuals(c, d, u, v, m, n_y, p->run_noise);
 }
 
+// One expensive run at (u, v): what the corrected map predicted there, the
+// run, whether it agreed, and the correction refitted with it. 1: the run
+// could not be done (out->failed set).
+static int run_at(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out, double u, double v)
+{
+    cal_mf_point *run = &out->run[out->n];
+    run->u = u, run->v = v;
+    cal_mf_predict(cheap, u, v, out->predicted[out->n]);
+    cal_mf_correct(&out->correction, p->n_y, u, v, out->predicted[out->n]);
+    if (p->run_expensive(u, v, run->y, p->ctx)) return out->failed = 1, 1;
+    out->agreed = agrees(run->y, out->predicted[out->n], p);
+    out->n++;
+    update_correction(cheap, out, p);
+    memset(out->delta, 0, sizeof out->delta);
+    cal_mf_correct(&out->correction, p->n_y, u, v, out->delta);
+    return 0;
+}
+
+static int budget_of(const cal_mf_problem *p) { return p->max_expensive < CAL_MF_MAX_FINE ? p->max_expensive : CAL_MF_MAX_FINE; }
+
 int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out)
 {
     memset(out, 0, sizeof *out);
     cal_mf_optimum(cheap, NULL, p, &out->u_uncorrected, &out->v_uncorrected);
-    int budget = p->max_expensive < CAL_MF_MAX_FINE ? p->max_expensive : CAL_MF_MAX_FINE;
+    int budget = budget_of(p);
     while (out->n < budget) {
         double u, v;
         cal_mf_optimum(cheap, &out->correction, p, &u, &v);
         if (already_run(out, u, v)) return out->settled = 1, 0;
-        cal_mf_point *run = &out->run[out->n];
-        run->u = u, run->v = v;
-        cal_mf_predict(cheap, u, v, out->predicted[out->n]);
-        cal_mf_correct(&out->correction, p->n_y, u, v, out->predicted[out->n]);
-        if (p->run_expensive(u, v, run->y, p->ctx)) return out->failed = 1, 0;
-        out->agreed = agrees(run->y, out->predicted[out->n], p);
-        out->n++;
-        update_correction(cheap, out, p);
-        memset(out->delta, 0, sizeof out->delta);
-        cal_mf_correct(&out->correction, p->n_y, u, v, out->delta);
+        if (run_at(cheap, p, out, u, v)) return 0;
         if (out->agreed) return 0;
     }
     return 0;
+}
+
+const char *cal_mf_refine(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_next_point next, void *ctx,
+                          cal_mf_result *out)
+{
+    if (out->failed) return "not tried: the search's last run failed";
+    for (int k = 0; k < more; ++k) {
+        if (out->n >= CAL_MF_MAX_FINE) return "stopped: no room for another run";
+        double u, v;
+        if (next(&out->correction, &u, &v, ctx)) return "stopped: the posterior's width is the data's own";
+        if (already_run(out, u, v)) return "stopped: the point asked for was already run";
+        if (run_at(cheap, p, out, u, v)) return "stopped: a simulation could not be stored";
+    }
+    return more > 0 ? "stopped at posterior_runs" : "not asked for (posterior_runs 0)";
 }

@@ -125,6 +125,18 @@ typedef struct cal_mf_result {
 /// Returns 0; out->failed says whether a run failed.
 int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out);
 
+/// Where the stage wants one more expensive run after the search, given the
+/// correction so far: 0 with (u, v), nonzero for none.
+typedef int (*cal_mf_next_point)(const cal_mf_correction *c, double *u, double *v, void *ctx);
+
+/// After cal_mf_search: up to `more` further runs, each where next() asks,
+/// appended to out->run with the correction refitted after each (agreed and
+/// delta then speak of the last of them). It stops early when next()
+/// declines, asks for a point already run (within 0.01) or a run fails.
+/// Returns why it stopped, for the report.
+const char *cal_mf_refine(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_next_point next, void *ctx,
+                          cal_mf_result *out);
+
 /// The corrected map's optimum over the unit square (a 41 × 41 scan, then
 /// NLopt BOBYQA from its best point).
 void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *c, const cal_mf_problem *p, double *u, double *v);

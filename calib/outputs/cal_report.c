@@ -471,7 +471,7 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                "corrected map put the optimum (%.0f s). Outcome: %s. The correction measured between the "
                "tiers (this tier minus the map, carried over the plane by %s, at the last run): angle %+.2f°",
             r->level[0].tier, r->level[0].runs, levels ? "runs of its own, on its own map" : "candidates",
-            r->level[0].wall_time_s, r->expensive_candidates, r->wall_time_s,
+            r->level[0].wall_time_s, r->expensive_candidates - r->posterior_runs, r->wall_time_s,
             r->two_tier_outcome ? r->two_tier_outcome : "not run", r->map_correction ? r->map_correction : "-",
             r->correction[0]);
     for (int j = 0; j < r->n_rpm; ++j) fprintf(f, ", CSA at %g rpm %+.2f points", r->rpm[j], r->correction[1 + j]);
@@ -479,6 +479,16 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                "where they stand, "
                "not runs of this tier: they enter the identified ranges, never the choice.\n\n",
             predicted, levels ? " and its predicted candidates" : "");
+    if (t->posterior_runs > 0)
+        fprintf(f, "After the loop, at most %d more run(s) of this tier where the posterior on the corrected map is "
+                   "still held wide by the map's own uncertainty: each at the posterior sample where the kriging's "
+                   "variance is the largest share of a measurement's whole variance, and none once that share, "
+                   "averaged over the posterior, is below %.0f %% for every measurement that moves with a parameter "
+                   "the data can tell (there the width is the data's own, and runs cannot narrow it). Made: %d; %s; "
+                   "the last share seen: %.0f %% (%s).\n\n",
+                t->posterior_runs, 100 * CAL_POSTERIOR_MAP_SHARE, r->posterior_runs,
+                r->posterior_runs_outcome ? r->posterior_runs_outcome : "not run", 100 * r->posterior_share,
+                r->posterior_share_of[0] ? r->posterior_share_of : "-");
 }
 
 static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds, const cal_tier *t)

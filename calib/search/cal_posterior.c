@@ -203,6 +203,50 @@ int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_
     return 0;
 }
 
+// Measurement k's kriging variance as a share of its whole variance at (u, v).
+static double map_share(const model *m, int k, double u, double v)
+{
+    double krig = cal_mf_correction_sd(m->correction, k, u, v);
+    double rest = m->data_sd[k] * m->data_sd[k] + m->map.rms[k] * m->map.rms[k];
+    return krig * krig / (rest + krig * krig);
+}
+
+// Whether measurement k moves by one data spread across the range of a parameter the data can tell.
+static int tells(const cal_posterior *p, int k)
+{
+    for (int q = 0; q < 2; ++q)
+        if (!cal_posterior_blind(p, q) && fabs(p->sensitivity[k][q]) >= 1) return 1;
+    return 0;
+}
+
+int cal_posterior_next_run(const cal_friction_result *r, const cal_bounds *b, const cal_posterior *p, double *u,
+                           double *v, cal_posterior_need *need)
+{
+    need->measurement = -1, need->share = 0;
+    model m;
+    cal_posterior scratch;
+    if (!r->has_map || p->n == 0 || build_model(r, b, &m, &scratch)) return 1;
+    for (int k = 0; k < p->n_y; ++k) {
+        if (!tells(p, k)) continue;
+        double sum = 0;
+        for (int i = 0; i < p->n; ++i) {
+            double su, sv;
+            cal_friction_to_unit(b, p->mu_s[i], p->mu_r[i], &su, &sv);
+            sum += map_share(&m, k, su, sv);
+        }
+        if (sum / p->n > need->share) need->share = sum / p->n, need->measurement = k;
+    }
+    if (need->measurement < 0 || need->share < CAL_POSTERIOR_MAP_SHARE) return 1;
+    double most = -1;
+    for (int i = 0; i < p->n; ++i) {
+        double su, sv;
+        cal_friction_to_unit(b, p->mu_s[i], p->mu_r[i], &su, &sv);
+        double share = map_share(&m, need->measurement, su, sv);
+        if (share > most) most = share, *u = su, *v = sv;
+    }
+    return 0;
+}
+
 const char *cal_posterior_reach_text(const cal_posterior *p, int k)
 {
     if (p->reaches_lower[k] && p->reaches_upper[k]) return " (both bounds)";

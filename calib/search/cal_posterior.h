@@ -57,6 +57,28 @@ const char *cal_posterior_reach_text(const cal_posterior *p, int k);
 /// 1 if no measurement moves by one data spread across parameter p's search range (0: μs, 1: μr).
 int cal_posterior_blind(const cal_posterior *p, int parameter);
 
+/// A run at this tier narrows the posterior only where the map's own
+/// uncertainty (the kriging's variance of the correction) holds it wide; where
+/// the data's spread and the map's residual make the width, more runs cannot
+/// narrow it. So: among the measurements that move by one data spread across
+/// a parameter the data can tell (cal_posterior_blind), the one whose kriging
+/// variance is the largest share of its whole variance, on average over the
+/// posterior's samples; if that share reaches CAL_POSTERIOR_MAP_SHARE, the
+/// next run goes to the sample where that measurement's share is largest.
+#define CAL_POSTERIOR_MAP_SHARE 0.25
+
+/// Which measurement asks for a run, and its share (see above).
+typedef struct cal_posterior_need {
+    int measurement; ///< index as in cal_posterior.observable; -1: none moves with a parameter the data tell
+    double share;    ///< its kriging variance share, mean over the samples
+} cal_posterior_need;
+
+/// Where the next run of a two-tier stage goes (unit square), by the rule
+/// above, from its posterior p (sampled on r's corrected map, r->has_map).
+/// 0 with (u, v) when one is wanted; 1 when none (need says why).
+int cal_posterior_next_run(const cal_friction_result *r, const cal_bounds *b, const cal_posterior *p, double *u,
+                           double *v, cal_posterior_need *need);
+
 void cal_posterior_free(cal_posterior *p);
 
 #endif

@@ -175,7 +175,8 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
 // Candidates the stage evaluates at most: the grid, COBYLA's, the bound probes.
 static int planned_candidates(const cal_tier *t)
 {
-    if (t->map_tier) return t->max_evaluations; // the two-tier loop's budget (its map tier plans its own)
+    if (t->map_tier) return t->max_evaluations + t->posterior_runs; // the two-tier loop's budget and the posterior's
+                                                                    // (its map tier plans its own)
     return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0);
 }
 

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "cal_multifidelity.h"
+#include "cal_posterior.h"
 #include "cal_stages.h"
 #include "exp_common.h"
 
@@ -36,6 +37,7 @@ typedef struct two_tier {
     cal_friction_search *search;
     cal_friction_result *r;
     const cal_bounds *bounds;
+    const cal_mf_map *map; ///< the cheap map, for the posterior between runs
 } two_tier;
 
 static int n_measurements(const cal_friction_result *r) { return 1 + r->n_rpm; }
@@ -185,18 +187,52 @@ static void keep_levels(cal_friction_result *out, const cal_friction_result *che
 // against their predictions, the outcome, the correction, and the map's
 // candidates corrected as predicted candidates.
 static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap, const double *cheap_noise,
-                      const cal_mf_map *map, const cal_mf_result *m, const char *tier, const cal_bounds *b)
+                      const cal_mf_map *map, const cal_mf_result *m, const char *loop_outcome, const char *tier,
+                      const cal_bounds *b)
 {
     out->has_map = !m->failed && m->n > 0, out->cheap_map = *map, out->discrepancy = m->correction;
-    out->expensive_candidates = m->n, out->two_tier_outcome = outcome_of(m);
+    out->expensive_candidates = m->n, out->two_tier_outcome = loop_outcome;
     out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
     for (int k = 0; k < n_measurements(out); ++k) out->correction[k] = m->delta[k];
     for (int i = 0; i < m->n; ++i)
         fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
                 tier, m->run[i].y[0], m->predicted[i][0]);
-    fprintf(stderr, "-- %s after %d run(s) at tier '%s'; correction at the last run: angle %+.2f°\n", out->two_tier_outcome,
-            m->n, tier, m->delta[0]);
+    fprintf(stderr, "-- %s after %d run(s) at tier '%s'", out->two_tier_outcome, m->n - out->posterior_runs, tier);
+    if (out->posterior_runs) fprintf(stderr, ", then %d where the posterior asked", out->posterior_runs);
+    fprintf(stderr, "; correction at the last run: angle %+.2f°\n", m->delta[0]);
     if (!m->failed && m->n > 0) add_predicted(out, cheap, cheap_noise, b, &m->correction);
+}
+
+// cal_mf_next_point for the runs after the loop: the posterior on the map
+// corrected so far, and where it asks for a run (cal_posterior_next_run).
+static int posterior_next(const cal_mf_correction *c, double *u, double *v, void *ctx)
+{
+    two_tier *t = ctx;
+    cal_friction_result *r = t->r;
+    r->has_map = 1, r->cheap_map = *t->map, r->discrepancy = *c;
+    cal_posterior post;
+    char why[200];
+    if (cal_posterior_sample(r, t->bounds, &post, why, sizeof why)) {
+        fprintf(stderr, "-- posterior: %s; no run after the loop\n", why);
+        return 1;
+    }
+    cal_posterior_need need;
+    int none = cal_posterior_next_run(r, t->bounds, &post, u, v, &need);
+    r->posterior_share = need.share;
+    snprintf(r->posterior_share_of, sizeof r->posterior_share_of, "%s",
+             need.measurement >= 0 ? post.observable[need.measurement] : "no measurement the data can tell");
+    if (none)
+        fprintf(stderr, "-- posterior: the map's own uncertainty is %.0f %% of the variance of %s (below %.0f %%): "
+                        "the width is the data's; no more runs\n", 100 * need.share, r->posterior_share_of,
+                100 * CAL_POSTERIOR_MAP_SHARE);
+    else {
+        double mu_s, mu_r;
+        cal_friction_to_mu(t->bounds, *u, *v, &mu_s, &mu_r);
+        fprintf(stderr, "-- posterior: the map's own uncertainty is %.0f %% of the variance of %s: one more run where "
+                        "it weighs most, mu_s = %.4g, mu_r = %.4g\n", 100 * need.share, r->posterior_share_of, mu_s, mu_r);
+    }
+    cal_posterior_free(&post);
+    return none;
 }
 
 // The level below, whole: the map tier's one-tier search, or where the map
@@ -256,7 +292,12 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     cal_mf_result *m = calloc(1, sizeof *m);
     if (!m) return cal_friction_finish(tt.search), exp_fail(err, len, "out of memory");
     cal_mf_search(&map, &p, m);
-    keep_loop(out, cheap, cheap_noise, &map, m, t->name, tt.bounds);
+    const char *loop_outcome = outcome_of(m);
+    int loop_runs = m->n;
+    tt.map = &map;
+    out->posterior_runs_outcome = cal_mf_refine(&map, &p, t->posterior_runs, posterior_next, &tt, m);
+    out->posterior_runs = m->n - loop_runs;
+    keep_loop(out, cheap, cheap_noise, &map, m, loop_outcome, t->name, tt.bounds);
     free(m);
     return cal_friction_finish(tt.search);
 }

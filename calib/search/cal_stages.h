@@ -139,6 +139,13 @@ typedef struct cal_friction_result {
     double map_u, map_v;                ///< the uncorrected cheap map's optimum (unit square)
     const char *two_tier_outcome;
     const char *map_correction;         ///< "kriging" or "affine" (cal_mf_correction_kind)
+    /// Of expensive_candidates, the runs after the loop where the posterior
+    /// asked (the tier's posterior_runs, cal_posterior_next_run), why they
+    /// stopped, and the last share of the map's uncertainty they saw.
+    int posterior_runs;
+    const char *posterior_runs_outcome;
+    double posterior_share;
+    char posterior_share_of[48];
     /// The map the two-tier search ended with: the map tier's quadratic map in
     /// this stage's unit square and the discrepancy measured at this tier's
     /// runs (the posterior samples it: cal_posterior.h). has_map 0: a one-tier

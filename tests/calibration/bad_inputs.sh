@@ -100,6 +100,12 @@ self=$(edit map_self 's/map_tier: check$/map_tier: check-two-tier/')
 expect "map tier itself" "map_self.yaml:$(line_of "$self" 'map_tier: check-two-tier$'): map_tier: 'check-two-tier' is this tier itself" -- "$self" "${out[@]}"
 cycle=$(edit map_cycle 's/map_tier: check$/map_tier: check-levels/')
 expect "map tiers in a cycle" "map_cycle.yaml:$(line_of "$cycle" 'map_tier: check-levels'): map_tier: the map tiers make a cycle (check-two-tier -> check-levels -> check-two-tier)" -- "$cycle" "${out[@]}"
+# posterior_runs (issue 35.4): a count in [0, 16], and only on a tier with a corrected map to refine.
+many=$(edit posterior_many 's/posterior_runs: 2$/posterior_runs: 17/')
+expect "posterior runs out of range" "posterior_many.yaml:$(line_of "$many" 'posterior_runs: 17'): posterior_runs: 17 must be in [0, 16]" -- "$many" "${out[@]}"
+alone=$(edit posterior_alone '/map_tier: ci$/d')
+# (the standard tier's is the last posterior_runs line; the check tiers keep their map_tier)
+expect "posterior runs without a map" "posterior_alone.yaml:$(grep -n 'posterior_runs: 2' "$alone" | tail -1 | cut -d: -f1): posterior_runs: only a tier with a map_tier" -- "$alone" "${out[@]}"
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -91,12 +92,65 @@ static void test_kriging_sd_is_the_nugget_at_a_run_and_the_scale_far_away(void *
     assert_float_equal(cal_mf_correction_sd(&c, 0, 0.5, 0.5), 0, 0);
 }
 
+// Kriging runs at (u, v) pairs with this scale, no residual weights (the
+// correction adds nothing: only its variance model matters here).
+static void kriging_at(cal_friction_result *r, const double *u, const double *v, int n, double scale)
+{
+    memset(&r->discrepancy, 0, sizeof r->discrepancy);
+    r->discrepancy.n_runs = n;
+    for (int i = 0; i < n; ++i) r->discrepancy.run_u[i] = u[i], r->discrepancy.run_v[i] = v[i];
+    r->discrepancy.scale[0] = scale, r->discrepancy.nugget[0] = 1e-9;
+}
+
+static void a_run_is_asked_only_where_the_map_holds_the_posterior_wide(void **state)
+{
+    (void)state;
+    cal_friction_result *r = linear_stage(); // the angle pins u near 0.5; v is blind
+    // The correction measured at two runs far from u = 0.5: there its variance (scale 2, against the angle's
+    // spread 0.5) is most of the angle's: a run is wanted, inside the posterior's mass.
+    const double far_u[] = {0.05, 0.95}, far_v[] = {0.5, 0.5};
+    kriging_at(r, far_u, far_v, 2, 2.0);
+    cal_posterior p;
+    char err[200];
+    assert_int_equal(cal_posterior_sample(r, &bounds, &p, err, sizeof err), 0);
+    double u = -1, v = -1;
+    cal_posterior_need need;
+    assert_int_equal(cal_posterior_next_run(r, &bounds, &p, &u, &v, &need), 0);
+    assert_int_equal(need.measurement, 0);
+    assert_true(need.share >= CAL_POSTERIOR_MAP_SHARE);
+    double mu_lo = p.lo[0], mu_hi = p.hi[0];
+    double at_mu_s = bounds.mu_s_min + u * (bounds.mu_s_max - bounds.mu_s_min);
+    assert_true(at_mu_s > mu_lo - 0.05 && at_mu_s < mu_hi + 0.05);
+    cal_posterior_free(&p);
+    // Runs along the posterior's ridge u = 0.5, every 0.2 in v, the discrepancy's scale the angle's spread:
+    // the kriging's variance is small wherever the posterior lies, the width is the angle's own: no run.
+    // (With a scale 4 times the spread, a run 0.05 off the ridge still leaves the kriging a third of the
+    // variance there: that map would still hold the posterior wide.)
+    const double ridge_u[] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5}, ridge_v[] = {0, 0.2, 0.4, 0.6, 0.8, 1.0};
+    kriging_at(r, ridge_u, ridge_v, 6, 0.5);
+    assert_int_equal(cal_posterior_sample(r, &bounds, &p, err, sizeof err), 0);
+    assert_int_equal(cal_posterior_next_run(r, &bounds, &p, &u, &v, &need), 1);
+    printf("ridge: the map's share of the angle's variance %.3f\n", need.share);
+    assert_int_equal(need.measurement, 0);
+    assert_true(need.share < CAL_POSTERIOR_MAP_SHARE);
+    cal_posterior_free(&p);
+    // A measurement that moves with no parameter the data can tell asks for nothing, however unsure the map.
+    r->cheap_map.coef[0][1] = 0.1; // the angle moves 0.2 spreads across μs: blind
+    kriging_at(r, far_u, far_v, 2, 2.0);
+    assert_int_equal(cal_posterior_sample(r, &bounds, &p, err, sizeof err), 0);
+    assert_int_equal(cal_posterior_next_run(r, &bounds, &p, &u, &v, &need), 1);
+    assert_int_equal(need.measurement, -1);
+    cal_posterior_free(&p);
+    free(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_linear_angle_gives_a_gaussian_in_mu_s_and_a_flat_mu_r),
         cmocka_unit_test(test_a_target_beyond_the_map_piles_on_the_bound),
         cmocka_unit_test(test_kriging_sd_is_the_nugget_at_a_run_and_the_scale_far_away),
+        cmocka_unit_test(a_run_is_asked_only_where_the_map_holds_the_posterior_wide),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Runs after the two-tier loop where the posterior asks for them (issue 35, item 4; posterior_runs,
+# docs/calibration.md). `granucal calibrate --tier check-posterior --stage granule` from scratch:
+#  - each run after the loop was asked for by the posterior, at the pair its "-- posterior:" line
+#    names, and that pair is one of the stage's candidates in simulations.csv;
+#  - the tier's candidates are the loop's runs plus those, at most max_evaluations + posterior_runs;
+#  - report.md says how many were made and why they stopped, as the log does;
+#  - the same command again runs nothing and writes the same table (the posterior is deterministic);
+#  - with posterior_runs: 0 the stage re-derives from the same store with 0 simulations: the loop's
+#    runs alone, and no word of runs after it.
+#   usage: posterior_runs.sh GRANUCAL SOURCE_DIR WORK_DIR
+set -euo pipefail
+bin=$1 src=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+cd "$src"
+args=(calibrate --tier check-posterior --stage granule --jobs 2 --checkpoint-every 0)
+run() { # run NAME CONFIG OUT
+  "$bin" "${args[@]}" "$2" --out "$3" > "$work/$1.out" 2> "$work/$1.log" || { cat "$work/$1.log"; exit 1; }
+}
+run first configs/calibration.yaml "$work/out"
+cp "$work/out/calibrated_parameters.csv" "$work/first.csv"
+run again configs/calibration.yaml "$work/out"
+sed 's/^    posterior_runs: 2$/    posterior_runs: 0/' configs/calibration.yaml > "$work/none.yaml"
+mkdir -p "$work/none" && cp -r "$work/out/store" "$work/none/"
+# The copied config reads its data relative to itself: point it at the shipped files.
+sed -i "s|\.\./experiments/|$src/experiments/|" "$work/none.yaml"
+run none "$work/none.yaml" "$work/none"
+python3 - "$work" configs/calibration.yaml <<'PY'
+import csv, re, sys
+work, config = sys.argv[1], sys.argv[2]
+fails = []
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok: fails.append(what)
+
+block = re.search(r"^  - name: check-posterior\n((?:    .*\n|\s*#.*\n)*)", open(config).read(), re.M).group(1)
+max_evaluations = int(re.search(r"^    max_evaluations: (\d+)", block, re.M).group(1))
+posterior_runs = int(re.search(r"^    posterior_runs: (\d+)", block, re.M).group(1))
+
+def deciding_pairs(out):
+    with open(f"{out}/simulations.csv") as f:
+        return {(float(r["mu_s"]), float(r["mu_r"])) for r in csv.DictReader(f) if r["stage"] == "granule"}
+
+log = open(f"{work}/first.log").read()
+asked = [(float(a), float(b)) for a, b in re.findall(r"^-- posterior: .*one more run where it weighs most, mu_s = (\S+), mu_r = (\S+)$", log, re.M)]
+loop = re.search(r"after (\d+) run\(s\) at tier 'check-posterior'(?:, then (\d+) where the posterior asked)?", log)
+check(loop is not None, "the log says how many runs the loop made")
+loop_runs, made = int(loop.group(1)), int(loop.group(2) or 0)
+check(made == len(asked), f"{made} run(s) after the loop, {len(asked)} asked for by the posterior")
+check(made > 0, "the posterior asked for a run (the test can fail: a tier whose width were the data's would ask none)")
+pairs = deciding_pairs(f"{work}/out")
+check(len(pairs) == loop_runs + made <= max_evaluations + posterior_runs,
+      f"{len(pairs)} candidates at the tier = {loop_runs} of the loop + {made} asked, at most {max_evaluations} + {posterior_runs}")
+for a in asked:
+    check(any(abs(p[0] - a[0]) <= 5e-4 * a[0] and abs(p[1] - a[1]) <= 5e-4 * a[1] for p in pairs),
+          f"the pair asked for (mu_s {a[0]}, mu_r {a[1]}) is a candidate in simulations.csv")
+report = open(f"{work}/out/report.md").read()
+said = re.search(r"After the loop, at most (\d+) more run\(s\).*?Made: (\d+); ([^;]+);", report, re.S)
+check(said is not None and int(said.group(1)) == posterior_runs and int(said.group(2)) == made,
+      "report.md says how many runs the posterior could ask for and how many were made")
+stop = re.search(r"^-- posterior: .*(no more runs)$", log, re.M)
+check(said is not None and (said.group(3) == "stopped at posterior_runs") == (stop is None and made == posterior_runs),
+      f"report.md says why they stopped ({said.group(3) if said else '-'}), as the log does")
+
+again = open(f"{work}/again.log").read()
+check(" 0 simulations run now" in again, "the same command again runs nothing")
+check(open(f"{work}/first.csv").read() == open(f"{work}/out/calibrated_parameters.csv").read(),
+      "and writes the same table, byte for byte")
+
+none = open(f"{work}/none.log").read()
+check(" 0 simulations run now" in none, "posterior_runs: 0 re-derives from the same store with 0 simulations")
+check(len(deciding_pairs(f"{work}/none")) == loop_runs, f"posterior_runs: 0 keeps the loop's {loop_runs} runs alone")
+check("After the loop" not in open(f"{work}/none/report.md").read(), "posterior_runs: 0: no word of runs after the loop")
+print(f"{len(fails)} failure(s)")
+sys.exit(1 if fails else 0)
+PY
