@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Lab data files: libcsv does the CSV grammar (quotes, separators); this
-// file checks the schema and the values, and counts lines for messages.
+// Lab data files: exp_csv (libcsv) reads the lines and does the CSV grammar
+// (quotes, separators); this file checks the schema and the values.
 #include "cal_data.h"
 
-#include <csv.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -13,14 +12,15 @@
 #include <strings.h>
 
 #include "exp_common.h"
+#include "exp_csv.h"
 
-enum { N_COLUMNS = 4 };
+enum { N_COLUMNS = 4, FIELD_CHARS = 64 };
 
 typedef struct reader {
     const char *path;
     cal_data_kind kind;
-    char fields[N_COLUMNS][64];
-    int n_fields, too_long, line, header_seen;
+    const exp_csv_row *row; ///< the row being read
+    int line, header_seen;
     cal_series *s;
     size_t cap;
     char *err;
@@ -33,17 +33,6 @@ static const char *const column_names[2][N_COLUMNS] = {
     {"surface", "rpm", "csa_percent", "csa_sd_percent"},
 };
 
-static void on_field(void *text, size_t n, void *ctx)
-{
-    reader *r = ctx;
-    if (r->n_fields < N_COLUMNS) {
-        if (n >= sizeof r->fields[0]) r->too_long = 1, n = sizeof r->fields[0] - 1;
-        memcpy(r->fields[r->n_fields], text ? text : "", n);
-        r->fields[r->n_fields][n] = '\0';
-    }
-    r->n_fields++;
-}
-
 static int fail_at(reader *r, const char *field, const char *fmt, const char *detail)
 {
     char msg[256];
@@ -54,7 +43,7 @@ static int fail_at(reader *r, const char *field, const char *fmt, const char *de
 
 static int parse_value(reader *r, int column, double lo, double hi, int lo_open, double *out)
 {
-    const char *text = r->fields[column], *name = column_names[r->kind][column];
+    const char *text = r->row->field[column], *name = column_names[r->kind][column];
     char *end;
     errno = 0;
     double v = strtod(text, &end);
@@ -73,7 +62,7 @@ static int parse_value(reader *r, int column, double lo, double hi, int lo_open,
 static void check_header(reader *r)
 {
     for (int c = 0; c < N_COLUMNS; ++c)
-        if (strcmp(r->fields[c], column_names[r->kind][c]) != 0) {
+        if (r->row->n != N_COLUMNS || strcmp(r->row->field[c], column_names[r->kind][c]) != 0) {
             char want[128];
             snprintf(want, sizeof want, "expected the header %s,%s,%s,%s", column_names[r->kind][0],
                      column_names[r->kind][1], column_names[r->kind][2], column_names[r->kind][3]);
@@ -86,13 +75,14 @@ static void check_header(reader *r)
 static void add_point(reader *r)
 {
     cal_point p = {.line = r->line};
-    if (!r->fields[0][0]) return (void)fail_at(r, "surface", "%s", "empty");
+    const char *surface = r->row->field[0];
+    if (!surface[0]) return (void)fail_at(r, "surface", "%s", "empty");
     // A quoted field may span lines in CSV, not in this schema (and a '#'
     // line inside it would have been dropped as a comment).
-    for (const char *c = r->fields[0]; *c; ++c)
+    for (const char *c = surface; *c; ++c)
         if (iscntrl((unsigned char)*c))
             return (void)fail_at(r, "surface", "%s", "holds a line break or a control character");
-    snprintf(p.surface, sizeof p.surface, "%s", r->fields[0]);
+    snprintf(p.surface, sizeof p.surface, "%.63s", surface); // too_long refused longer
     double hi = r->kind == CAL_DATA_ANGLE ? 90 : 100;
     if (parse_value(r, 1, 0, 1000, 1, &p.rpm) || parse_value(r, 2, 0, hi, 1, &p.value) ||
         parse_value(r, 3, 0, hi, 0, &p.sd))
@@ -112,32 +102,33 @@ static void add_point(reader *r)
     r->s->points[r->s->count++] = p;
 }
 
-static void on_row(int terminator, void *ctx)
+// A field longer than this schema allows.
+static int too_long(const exp_csv_row *row)
 {
-    (void)terminator;
-    reader *r = ctx;
-    if (r->failed) return;
-    if (!r->header_seen) {
-        if (r->n_fields != N_COLUMNS) r->fields[0][0] = '\0'; // not the header, whatever its fields
-        check_header(r);
-    } else if (r->n_fields != N_COLUMNS) {
-        char n[32];
-        snprintf(n, sizeof n, "%d", r->n_fields);
-        fail_at(r, "row", "has %s fields, expected 4", n);
-    } else if (r->too_long) fail_at(r, "row", "%s", "a field is longer than 63 characters");
-    else add_point(r);
-    r->n_fields = 0, r->too_long = 0;
+    if (row->too_long) return 1;
+    for (int c = 0; c < N_COLUMNS; ++c)
+        if (strlen(row->field[c]) >= FIELD_CHARS) return 1;
+    return 0;
 }
 
-static int blank_or_comment(const char *line)
+static int on_row(const exp_csv_row *row, void *ctx)
 {
-    while (*line == ' ' || *line == '\t' || *line == '\r') line++;
-    return *line == '#' || *line == '\n' || *line == '\0';
+    reader *r = ctx;
+    r->row = row, r->line = row->line;
+    if (!r->header_seen) check_header(r);
+    else if (row->n != N_COLUMNS) {
+        char n[32];
+        snprintf(n, sizeof n, "%d", row->n);
+        fail_at(r, "row", "has %s fields, expected 4", n);
+    } else if (too_long(row)) fail_at(r, "row", "%s", "a field is longer than 63 characters");
+    else add_point(r);
+    return r->failed;
 }
 
 // A comment line that says the numbers are synthetic, and at what lambda.
-static void read_provenance(const char *line, cal_series *s)
+static void read_provenance(const char *line, void *ctx)
 {
+    cal_series *s = ((reader *)ctx)->s;
     if (!strstr(line, "SYNTHETIC")) return;
     s->synthetic = 1;
     const char *at = strstr(line, "lambda ");
@@ -151,38 +142,11 @@ int cal_series_load(cal_series *s, const char *path, cal_data_kind kind, char *e
     memset(s, 0, sizeof *s);
     snprintf(s->path, sizeof s->path, "%s", path);
     s->synthetic_lambda = NAN;
-    FILE *f = fopen(path, "r");
-    if (!f) return exp_fail(err, len, "%s: cannot open: %s", path, strerror(errno));
-    struct csv_parser p;
-    csv_init(&p, CSV_STRICT | CSV_APPEND_NULL | CSV_STRICT_FINI);
     reader r = {.path = path, .kind = kind, .s = s, .err = err, .len = len};
-    char *line = NULL;
-    size_t cap = 0;
-    ssize_t n;
-    // One physical line at a time so every row knows its line number; a
-    // quoted newline inside a field is not part of this schema.
-    while (!r.failed && (n = getline(&line, &cap, f)) > 0) {
-        r.line++;
-        // A NUL byte would end the line early for the C string checks (a line
-        // starting with one read as blank) and cut a field short for strtod.
-        if (memchr(line, '\0', (size_t)n)) {
-            fail_at(&r, "row", "%s", "contains a NUL byte: not a text file");
-            break;
-        }
-        if (blank_or_comment(line)) {
-            read_provenance(line, s);
-            continue;
-        }
-        if (csv_parse(&p, line, (size_t)n, on_field, on_row, &r) != (size_t)n && !r.failed)
-            fail_at(&r, "row", "malformed CSV (%s)", csv_strerror(csv_error(&p)));
-        if (!r.failed && line[n - 1] != '\n') csv_fini(&p, on_field, on_row, &r);
-    }
-    if (!r.failed && csv_fini(&p, on_field, on_row, &r) != 0) fail_at(&r, "row", "%s", "unterminated quoted field");
-    free(line);
-    csv_free(&p);
-    fclose(f);
-    if (!r.failed && !r.header_seen) r.line = 1, fail_at(&r, "header", "%s", "the file is empty (no header row)");
-    if (!r.failed && s->count == 0) fail_at(&r, "row", "%s", "no measurements after the header");
+    // exp_csv writes its own messages (the file, a NUL byte, malformed CSV) and stops on ours.
+    if (exp_csv_read(path, on_row, read_provenance, &r, err, len)) r.failed = 1;
+    else if (!r.header_seen) r.line = 1, fail_at(&r, "header", "%s", "the file is empty (no header row)");
+    else if (s->count == 0) fail_at(&r, "row", "%s", "no measurements after the header");
     if (r.failed) cal_series_free(s);
     return r.failed;
 }

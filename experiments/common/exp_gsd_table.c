@@ -3,7 +3,6 @@
 // exp_gsd_table.h for the format.
 #include "exp_gsd_table.h"
 
-#include <csv.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,11 +10,15 @@
 #include <string.h>
 
 #include "exp_common.h"
+#include "exp_csv.h"
 
 static const char HEADER[] = "size_um,cumulative_percent";
 
 typedef struct table_reader {
     const char *path;
+    char *err;
+    size_t len;
+    int header_seen;
     int rows;
     double size_m[DEM_GSD_TABLE_MAX_ROWS], percent[DEM_GSD_TABLE_MAX_ROWS];
     int line_of[DEM_GSD_TABLE_MAX_ROWS]; ///< file line of each row, for messages
@@ -48,76 +51,42 @@ static int parse_number(const char *path, int line, const char *field, char *tex
     return 0;
 }
 
-// The fields of one line as libcsv splits it (quoting and all), at most
-// MAX_FIELDS kept; n counts them all.
-enum { MAX_FIELDS = 3, FIELD_CHARS = 64 };
-typedef struct line_fields {
-    int n;
-    char text[MAX_FIELDS][FIELD_CHARS];
-} line_fields;
-
-static void on_field(void *s, size_t len, void *data)
-{
-    line_fields *l = data;
-    if (l->n < MAX_FIELDS) snprintf(l->text[l->n], FIELD_CHARS, "%.*s", (int)len, s ? (const char *)s : "");
-    l->n++;
-}
-
-static void on_row(int c, void *data) { (void)c, (void)data; }
-
-// One line's fields (one line is one row in this schema); 1 if libcsv finds it malformed.
-static int split_line(struct csv_parser *p, const char *line, line_fields *l)
-{
-    memset(l, 0, sizeof *l);
-    return csv_parse(p, line, strlen(line), on_field, on_row, l) != strlen(line) ||
-           csv_fini(p, on_field, on_row, l) != 0;
-}
-
 // A data row "size,percent" into the reader.
-static int add_row(table_reader *r, int line, line_fields *l, char *err, size_t len)
+static int add_row(table_reader *r, const exp_csv_row *row)
 {
-    if (l->n != 2) return exp_fail(err, len, "%s:%d: row: expected 2 fields (%s)", r->path, line, HEADER);
+    char *err = r->err;
+    size_t len = r->len;
+    int line = row->line;
+    if (row->n != 2) return exp_fail(err, len, "%s:%d: row: expected 2 fields (%s)", r->path, line, HEADER);
+    if (row->too_long) return exp_fail(err, len, "%s:%d: row: a field is longer than %d characters", r->path, line,
+                                       EXP_CSV_FIELD_CHARS - 1);
     if (r->rows == DEM_GSD_TABLE_MAX_ROWS)
         return exp_fail(err, len, "%s:%d: row: more than %d rows", r->path, line, DEM_GSD_TABLE_MAX_ROWS);
+    char size_text[EXP_CSV_FIELD_CHARS], percent_text[EXP_CSV_FIELD_CHARS];
+    memcpy(size_text, row->field[0], sizeof size_text), memcpy(percent_text, row->field[1], sizeof percent_text);
     double size_um = 0, percent = 0;
-    if (parse_number(r->path, line, "size_um", l->text[0], &size_um, err, len) ||
-        parse_number(r->path, line, "cumulative_percent", l->text[1], &percent, err, len))
+    if (parse_number(r->path, line, "size_um", size_text, &size_um, err, len) ||
+        parse_number(r->path, line, "cumulative_percent", percent_text, &percent, err, len))
         return 1;
     r->size_m[r->rows] = size_um * 1e-6, r->percent[r->rows] = percent, r->line_of[r->rows] = line;
     r->rows++;
     return 0;
 }
 
-static int is_header(line_fields *l)
+static int is_header(const exp_csv_row *row)
 {
-    return l->n == 2 && !strcmp(trim(l->text[0]), "size_um") && !strcmp(trim(l->text[1]), "cumulative_percent");
+    char a[EXP_CSV_FIELD_CHARS], b[EXP_CSV_FIELD_CHARS];
+    memcpy(a, row->field[0], sizeof a), memcpy(b, row->field[1], sizeof b);
+    return row->n == 2 && !strcmp(trim(a), "size_um") && !strcmp(trim(b), "cumulative_percent");
 }
 
-// Line by line (so that every message names its line), comments and blank
-// lines skipped, each line split by libcsv.
-static int read_rows(FILE *f, table_reader *r, char *err, size_t len)
+// exp_csv_on_row: the header first, then the data rows.
+static int on_row(const exp_csv_row *row, void *ctx)
 {
-    char text[256];
-    int line = 0, header_seen = 0, bad = 0;
-    struct csv_parser p;
-    csv_init(&p, CSV_STRICT | CSV_APPEND_NULL | CSV_STRICT_FINI);
-    while (!bad && fgets(text, sizeof text, f)) {
-        line++;
-        if (!strchr(text, '\n') && !feof(f))
-            bad = exp_fail(err, len, "%s:%d: row: longer than %zu characters", r->path, line, sizeof text - 2);
-        char *t = trim(text);
-        if (bad || *t == '#' || *t == '\0') continue;
-        line_fields l;
-        if (split_line(&p, t, &l))
-            bad = exp_fail(err, len, "%s:%d: row: malformed CSV (%s)", r->path, line, csv_strerror(csv_error(&p)));
-        else if (!header_seen) {
-            header_seen = is_header(&l);
-            if (!header_seen) bad = exp_fail(err, len, "%s:%d: header: expected %s", r->path, line, HEADER);
-        } else bad = add_row(r, line, &l, err, len);
-    }
-    csv_free(&p);
-    if (!bad && !header_seen) return exp_fail(err, len, "%s: header: the file is empty (expected %s)", r->path, HEADER);
-    return bad;
+    table_reader *r = ctx;
+    if (r->header_seen) return add_row(r, row);
+    r->header_seen = is_header(row);
+    return r->header_seen ? 0 : exp_fail(r->err, r->len, "%s:%d: header: expected %s", r->path, row->line, HEADER);
 }
 
 int exp_gsd_table_load(const char *path, const char *basis_name, dem_gsd *out, char *err, size_t len)
@@ -128,14 +97,10 @@ int exp_gsd_table_load(const char *path, const char *basis_name, dem_gsd *out, c
                                   "or number", basis_name ? basis_name : "(absent)");
     table_reader *r = calloc(1, sizeof *r);
     if (!r) return exp_fail(err, len, "out of memory");
-    r->path = path;
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        free(r);
-        return exp_fail(err, len, "%s: cannot open: %s", path, strerror(errno));
-    }
-    int bad = read_rows(f, r, err, len);
-    fclose(f);
+    r->path = path, r->err = err, r->len = len;
+    // exp_csv skips comments and blank lines and writes its own messages (the file, malformed CSV).
+    int bad = exp_csv_read(path, on_row, NULL, r, err, len);
+    if (!bad && !r->header_seen) bad = exp_fail(err, len, "%s: header: the file is empty (expected %s)", path, HEADER);
     char msg[300];
     int row = -1;
     if (!bad && dem_gsd_from_table(r->size_m, r->percent, r->rows, basis, out, &row, msg, sizeof msg)) {

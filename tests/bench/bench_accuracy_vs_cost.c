@@ -12,62 +12,48 @@
 // A run that took stage 1 from another run's folder lists none of it: +H adds
 // those core-hours, so that every level carries the same stage 1.
 //   usage: bench_accuracy_vs_cost OUT.png LABEL=RESULTS_DIR[+H] [LABEL=RESULTS_DIR[+H] ...]
-#include <csv.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "exp_csv.h"
 #include "exp_plot.h"
 
-enum { MAX_LEVELS = 8, MAX_FIELDS = 32, FIELD_LEN = 160, MAX_FRICTIONS = 8 };
+enum { MAX_LEVELS = 8, MAX_FRICTIONS = 8 };
 
-// One CSV file read row by row through libcsv: the header's names, then each row's fields.
+// One CSV file read by its header's names (exp_csv): the header, then each row to on_row.
 typedef struct csv_rows {
-    char header[MAX_FIELDS][FIELD_LEN], field[MAX_FIELDS][FIELD_LEN];
-    int n_header, n_field, row;
+    exp_csv_row header;
+    const exp_csv_row *row;
+    int header_seen;
     void (*on_row)(struct csv_rows *r, void *ctx);
     void *ctx;
 } csv_rows;
 
-static void on_field(void *s, size_t len, void *data)
+static int on_csv_row(const exp_csv_row *row, void *data)
 {
     csv_rows *r = data;
-    char(*to)[FIELD_LEN] = r->row == 0 ? r->header : r->field;
-    int *n = r->row == 0 ? &r->n_header : &r->n_field;
-    if (*n < MAX_FIELDS) snprintf(to[(*n)++], FIELD_LEN, "%.*s", (int)len, (const char *)s);
-}
-
-static void on_row(int c, void *data)
-{
-    (void)c;
-    csv_rows *r = data;
-    if (r->row++ > 0) r->on_row(r, r->ctx);
-    r->n_field = 0;
+    if (!r->header_seen) r->header = *row, r->header_seen = 1;
+    else r->row = row, r->on_row(r, r->ctx);
+    return 0;
 }
 
 static const char *field(const csv_rows *r, const char *name)
 {
-    for (int k = 0; k < r->n_header && k < r->n_field; ++k)
-        if (strcmp(r->header[k], name) == 0) return r->field[k];
-    return "";
+    int k = exp_csv_column(&r->header, name);
+    return k >= 0 && k < r->row->n && k < EXP_CSV_MAX_FIELDS ? r->row->field[k] : "";
 }
 
 static int read_csv(const char *path, void (*row)(csv_rows *, void *), void *ctx)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) return fprintf(stderr, "%s: cannot read\n", path), 1;
     csv_rows *r = calloc(1, sizeof *r);
-    struct csv_parser p;
-    if (!r || csv_init(&p, CSV_APPEND_NULL) != 0) return fclose(f), free(r), 1;
+    if (!r) return 1;
     r->on_row = row, r->ctx = ctx;
-    char buf[4096];
-    size_t n;
-    int bad = 0;
-    while (!bad && (n = fread(buf, 1, sizeof buf, f)) > 0) bad = csv_parse(&p, buf, n, on_field, on_row, r) != n;
-    bad |= csv_fini(&p, on_field, on_row, r) != 0;
-    if (bad) fprintf(stderr, "%s: %s\n", path, csv_strerror(csv_error(&p)));
-    csv_free(&p), fclose(f), free(r);
+    char err[1200];
+    int bad = exp_csv_read(path, on_csv_row, NULL, r, err, sizeof err);
+    if (bad) fprintf(stderr, "%s\n", err);
+    free(r);
     return bad;
 }
 

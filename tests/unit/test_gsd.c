@@ -472,6 +472,9 @@ static void test_table_file(void **state)
         {"# c\nsize,percent\n100,0\n400,100\n", "volume", ":2: header: expected size_um,cumulative_percent"},
         {"size_um,cumulative_percent\n100,0\n", "volume", ": rows: 1 given"},
         {"size_um,cumulative_percent\n100,0\n400,100\n", "mass", "gsd_basis: 'mass'"},
+        // The CSV grammar (exp_csv, libcsv): a stray quote, a quote left open at the end of its line.
+        {"size_um,cumulative_percent\n100,0\n2\"00,40\n400,100\n", "volume", ":3: row: malformed CSV"},
+        {"size_um,cumulative_percent\n100,0\n\"200,40\n400,100\n", "volume", ":3: row: unterminated quoted field"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
         path = write_temp(bad[k].text);
