@@ -308,7 +308,7 @@ const char *cal_mf_refine(const cal_mf_map *cheap, const cal_mf_problem *p, int 
     for (int k = 0; k < more; ++k) {
         if (out->n >= CAL_MF_MAX_FINE) return "stopped: no room for another run";
         double u, v;
-        if (next(&out->correction, &u, &v, ctx)) return "stopped: the posterior's width is the data's own";
+        if (next(&out->correction, &u, &v, ctx)) return "stopped: the stage asked for no more runs";
         if (already_run(out, u, v)) return "stopped: the point asked for was already run";
         if (run_at(cheap, p, out, u, v)) return "stopped: a simulation could not be stored";
     }

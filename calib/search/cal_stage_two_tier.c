@@ -221,7 +221,10 @@ static int posterior_next(const cal_mf_correction *c, double *u, double *v, void
     r->posterior_share = need.share;
     snprintf(r->posterior_share_of, sizeof r->posterior_share_of, "%s",
              need.measurement >= 0 ? post.observable[need.measurement] : "no measurement the data can tell");
-    if (none)
+    if (none && need.measurement < 0)
+        fprintf(stderr, "-- posterior: no measurement moves by one data spread with a parameter the data can tell: "
+                        "no run would narrow it; no more runs\n");
+    else if (none)
         fprintf(stderr, "-- posterior: the map's own uncertainty is %.0f %% of the variance of %s (below %.0f %%): "
                         "the width is the data's; no more runs\n", 100 * need.share, r->posterior_share_of,
                 100 * CAL_POSTERIOR_MAP_SHARE);

@@ -343,7 +343,7 @@ static void runs_after_the_loop_go_where_asked_and_correct_the_map(void **state)
     for (int k = 0; k < N_Y; ++k) assert_float_equal(y[k], truth[k], 1e-6); // three runs: the plane is exact
     // Declined: nothing run. Asked for a point already run: nothing run.
     asks none = {{0}, {0}, 0, 0}, again = {{0.2}, {0.1}, 1, 0};
-    assert_string_equal(cal_mf_refine(&map, &p, 2, next_of_list, &none, &r), "stopped: the posterior's width is the data's own");
+    assert_string_equal(cal_mf_refine(&map, &p, 2, next_of_list, &none, &r), "stopped: the stage asked for no more runs");
     assert_string_equal(cal_mf_refine(&map, &p, 2, next_of_list, &again, &r), "stopped: the point asked for was already run");
     assert_string_equal(cal_mf_refine(&map, &p, 0, next_of_list, &none, &r), "not asked for (posterior_runs 0)");
     assert_int_equal(r.n, 3);
