@@ -640,7 +640,7 @@ static int plan_cost(run *r, plan *p)
     plan_pass pass[2] = {{.worst = 0, .k_n = p->k_expected, .parallel = parallel},
                          {.worst = 1, .k_n = p->k_worst, .parallel = parallel}};
     if (wants(r, "stiffness")) {
-        cal_plan *c = plan_step(p, "stiffness", "poured cylinders");
+        cal_plan *c = plan_step(p, "stiffness", cal_tier_stiffness_on_drum(r->t) ? "poured drum beds" : "poured cylinders");
         plan_cylinders(r, parallel, &c->expected), plan_cylinders(r, parallel, &c->worst);
     }
     if (wants(r, "granule") && plan_friction_steps(r, p, pass, NULL, "granule")) return 1;

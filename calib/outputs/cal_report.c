@@ -594,8 +594,10 @@ static void report_cost(FILE *f, const cal_outcome *o, const sim_tally *t)
         else fprintf(f, ", %d at tier '%s', map tier of '%s'", t->count[TALLY_LEVEL + k], below->name, above->name);
         fprintf(f, " (%.2f)", t->core_s[TALLY_LEVEL + k] / 3600);
     }
-    fprintf(f, ", %d poured cylinders (%.2f). A run two stages share (the same candidate for two wall materials) is "
-               "counted once here and under each stage above", t->count[TALLY_CYLINDER], t->core_s[TALLY_CYLINDER] / 3600);
+    fprintf(f, ", %d %s (%.2f). A run two stages share (the same candidate for two wall materials) is "
+               "counted once here and under each stage above", t->count[TALLY_CYLINDER],
+            cal_tier_stiffness_on_drum(o->tier) ? "poured drum beds of stage 1" : "poured cylinders",
+            t->core_s[TALLY_CYLINDER] / 3600);
     fputs(". For scale: the paper ran 14 poured cylinders for the stiffness (section 4.1) and, per drum lining, "
           "a grid of (μs, μr) pairs (Fig. 13, 17) at λ = 64, 200 000 granules, 6 s each; the reference calibration "
           "systems spend about 80 (GrainLearning) to 480 (ACCES) simulations per calibration.\n", f);
