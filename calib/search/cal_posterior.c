@@ -226,24 +226,25 @@ int cal_posterior_next_run(const cal_friction_result *r, const cal_bounds *b, co
     model m;
     cal_posterior scratch;
     if (!r->has_map || p->n == 0 || build_model(r, b, &m, &scratch)) return 1;
-    for (int k = 0; k < p->n_y; ++k) {
-        if (!tells(p, k)) continue;
-        double sum = 0;
-        for (int i = 0; i < p->n; ++i) {
-            double su, sv;
-            cal_friction_to_unit(b, p->mu_s[i], p->mu_r[i], &su, &sv);
-            sum += map_share(&m, k, su, sv);
-        }
-        if (sum / p->n > need->share) need->share = sum / p->n, need->measurement = k;
-    }
-    if (need->measurement < 0 || need->share < CAL_POSTERIOR_MAP_SHARE) return 1;
-    double most = -1;
+    // One pass over the samples: each told measurement's summed share, and the sample where it is largest.
+    double sum[CAL_MF_MAX_Y] = {0}, most[CAL_MF_MAX_Y], at_u[CAL_MF_MAX_Y], at_v[CAL_MF_MAX_Y];
+    int told[CAL_MF_MAX_Y];
+    for (int k = 0; k < p->n_y; ++k) told[k] = tells(p, k), most[k] = -1;
     for (int i = 0; i < p->n; ++i) {
         double su, sv;
         cal_friction_to_unit(b, p->mu_s[i], p->mu_r[i], &su, &sv);
-        double share = map_share(&m, need->measurement, su, sv);
-        if (share > most) most = share, *u = su, *v = sv;
+        for (int k = 0; k < p->n_y; ++k) {
+            if (!told[k]) continue;
+            double share = map_share(&m, k, su, sv);
+            sum[k] += share;
+            if (share > most[k]) most[k] = share, at_u[k] = su, at_v[k] = sv;
+        }
     }
+    for (int k = 0; k < p->n_y; ++k)
+        if (told[k] && (need->measurement < 0 || sum[k] / p->n > need->share))
+            need->share = sum[k] / p->n, need->measurement = k;
+    if (need->measurement < 0 || need->share < CAL_POSTERIOR_MAP_SHARE) return 1;
+    *u = at_u[need->measurement], *v = at_v[need->measurement];
     return 0;
 }
 
