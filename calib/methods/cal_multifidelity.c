@@ -95,7 +95,7 @@ double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double 
         for (size_t i = 0; i < m; ++i) {
             gsl_vector_set(kx, i, kernel(u, v, c->run_u[i], c->run_v[i]));
             for (size_t j = 0; j < m; ++j)
-                gsl_matrix_set(K, i, j, kernel(c->run_u[i], c->run_v[i], c->run_u[j], c->run_v[j]) + (i == j ? c->nugget[k] : 0));
+                gsl_matrix_set(K, i, j, kernel(c->run_u[i], c->run_v[i], c->run_u[j], c->run_v[j]) + (i == j ? c->nugget[k][i] : 0));
         }
         gsl_error_handler_t *old = gsl_set_error_handler_off();
         if (!gsl_linalg_cholesky_decomp1(K) && !gsl_linalg_cholesky_solve(K, kx, a))
@@ -160,18 +160,37 @@ void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *correction, 
     *u = x[0], *v = x[1];
 }
 
-static int agrees(const double *measured, const double *predicted, const cal_mf_problem *p)
+// The run's noise for measurement k: the problem's, or the run's own where larger.
+static double run_error(const cal_mf_problem *p, const cal_mf_point *run, int k)
+{
+    double noise = p->run_noise ? p->run_noise[k] : 0;
+    return fmax(noise, run->sd[k]);
+}
+
+// A run with an error of its own above the problem's run noise (not steady).
+static int noisy(const cal_mf_problem *p, const cal_mf_point *run)
 {
     for (int k = 0; k < p->n_y; ++k)
-        if (!(fabs(measured[k] - predicted[k]) <= p->noise[k])) return 0;
+        if (run->sd[k] > (p->run_noise ? p->run_noise[k] : 0)) return 1;
+    return 0;
+}
+
+// Agreement within the data's noise. A noisy run cannot show it: its own
+// error is larger than the tier's, so a match within the noise says little.
+static int agrees(const cal_mf_point *run, const double *predicted, const cal_mf_problem *p)
+{
+    if (noisy(p, run)) return 0;
+    for (int k = 0; k < p->n_y; ++k)
+        if (!(fabs(run->y[k] - predicted[k]) <= p->noise[k])) return 0;
     return 1;
 }
 
-static int already_run(const cal_mf_result *r, double u, double v)
+// The run within 0.01 of (u, v), or NULL.
+static const cal_mf_point *already_run(const cal_mf_result *r, double u, double v)
 {
     for (int i = 0; i < r->n; ++i)
-        if (fabs(r->run[i].u - u) <= 0.01 && fabs(r->run[i].v - v) <= 0.01) return 1;
-    return 0;
+        if (fabs(r->run[i].u - u) <= 0.01 && fabs(r->run[i].v - v) <= 0.01) return &r->run[i];
+    return NULL;
 }
 
 static int measured(const cal_mf_point *p, int n_y)
@@ -182,14 +201,15 @@ static int measured(const cal_mf_point *p, int n_y)
 }
 
 // Kriging of what the plane leaves at the runs, per measurement: weights w
-// solving (K + r·I) w = residuals, K the kernel between the runs and r the
-// runs' own noise over the residuals' scale, (noise / max(rms, noise))²: near
-// 0 (interpolation) when the residuals stand well above the noise, 1 (a
-// smoothed fit) when they are noise; at least 1e-9, to keep K + r·I positive
-// definite. The weights stay 0 for a measurement whose system GSL cannot
-// factor.
+// solving (K + R) w = residuals, K the kernel between the runs and R the
+// diagonal of each run's noise over the residuals' scale, (err_i / max(rms,
+// noise))²: near 0 (interpolation) when the residuals stand well above the
+// noise, 1 (a smoothed fit) when they are noise, more for a run whose own
+// error (not steady) exceeds the tier's noise; at least 1e-9, to keep K + R
+// positive definite. The weights stay 0 for a measurement whose system GSL
+// cannot factor.
 static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], const double *u, const double *v, int m,
-                            int n_y, const double *run_noise)
+                            int n_y, const double *run_noise, double err[][CAL_MF_MAX_Y])
 {
     c->n_runs = m;
     for (int i = 0; i < m; ++i) c->run_u[i] = u[i], c->run_v[i] = v[i];
@@ -202,15 +222,18 @@ static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], cons
             gsl_vector_set(r, (size_t)i, e), ss += e * e;
         }
         double noise = run_noise ? run_noise[k] : 0, scale = fmax(sqrt(ss / m), noise);
-        double ratio = scale > 0 ? noise * noise / (scale * scale) : 1;
+        for (int i = 0; i < m; ++i) {
+            double e = err[i][k], ratio = scale > 0 ? e * e / (scale * scale) : 1;
+            c->nugget[k][i] = fmax(ratio, 1e-9);
+        }
         for (int i = 0; i < m; ++i)
             for (int j = 0; j < m; ++j)
-                gsl_matrix_set(K, (size_t)i, (size_t)j, kernel(u[i], v[i], u[j], v[j]) + (i == j ? fmax(ratio, 1e-9) : 0));
+                gsl_matrix_set(K, (size_t)i, (size_t)j, kernel(u[i], v[i], u[j], v[j]) + (i == j ? c->nugget[k][i] : 0));
         gsl_error_handler_t *old = gsl_set_error_handler_off();
         int bad = gsl_linalg_cholesky_decomp1(K) || gsl_linalg_cholesky_solve(K, r, w);
         gsl_set_error_handler(old);
         for (int i = 0; i < m; ++i) c->weight[k][i] = bad ? 0 : gsl_vector_get(w, (size_t)i);
-        c->scale[k] = bad ? 0 : scale, c->nugget[k] = fmax(ratio, 1e-9);
+        c->scale[k] = bad ? 0 : scale;
     }
     gsl_matrix_free(K), gsl_vector_free(r), gsl_vector_free(w);
 }
@@ -218,23 +241,57 @@ static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], cons
 // A least-squares slope from the centred sums of squares and cross products.
 static double slope(double sxx, double sxd) { return sxx > 0 ? sxd / sxx : 0; }
 
+// The plane of measurement k's discrepancies d by weighted least squares
+// (GSL), each run weighed by 1/err²: the mean at (u0, v0) and the slopes
+// along the directions kept. For runs of unequal errors (one not steady).
+static void weighted_plane(cal_mf_correction *c, int k, double d[][CAL_MF_MAX_Y], double err[][CAL_MF_MAX_Y],
+                           const double *u, const double *v, int m, int use_u, int use_v)
+{
+    const size_t n = (size_t)m, p = (size_t)(1 + use_u + use_v);
+    gsl_matrix *X = gsl_matrix_alloc(n, p), *cov = gsl_matrix_alloc(p, p);
+    gsl_vector *w = gsl_vector_alloc(n), *y = gsl_vector_alloc(n), *b = gsl_vector_alloc(p);
+    gsl_multifit_linear_workspace *work = gsl_multifit_linear_alloc(n, p);
+    if (X && cov && w && y && b && work) {
+        for (size_t i = 0; i < n; ++i) {
+            size_t j = 0;
+            gsl_matrix_set(X, i, j++, 1);
+            if (use_u) gsl_matrix_set(X, i, j++, u[i] - c->u0);
+            if (use_v) gsl_matrix_set(X, i, j++, v[i] - c->v0);
+            gsl_vector_set(w, i, 1 / fmax(err[i][k] * err[i][k], 1e-300)), gsl_vector_set(y, i, d[i][k]);
+        }
+        double chisq;
+        gsl_error_handler_t *old = gsl_set_error_handler_off();
+        if (!gsl_multifit_wlinear(X, w, y, b, cov, &chisq, work)) {
+            c->at[k] = gsl_vector_get(b, 0);
+            if (use_u) c->du[k] = gsl_vector_get(b, 1);
+            if (use_v) c->dv[k] = gsl_vector_get(b, (size_t)use_u + 1);
+        }
+        gsl_set_error_handler(old);
+    }
+    gsl_matrix_free(X), gsl_matrix_free(cov), gsl_vector_free(w), gsl_vector_free(y), gsl_vector_free(b);
+    if (work) gsl_multifit_linear_free(work);
+}
+
 // The correction: the discrepancy (run - cheap map) of the runs that measured
 // everything, its mean at their centre and, with three runs or more, its
 // slopes along each direction they span (least squares on the centred
 // coordinates: both at once where both are spanned); with kriging and two
-// runs or more, what that plane leaves at the runs is kriged on top.
+// runs or more, what that plane leaves at the runs is kriged on top. A run
+// with an error of its own (not steady) counts by it: the plane is then
+// weighted least squares, and its kriging nugget is its own.
 static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const cal_mf_problem *p)
 {
     const int n_y = p->n_y;
     enum { MIN_RUNS_FOR_SLOPES = 3 };
     const double min_span = 0.05;
-    double d[CAL_MF_MAX_FINE][CAL_MF_MAX_Y], u[CAL_MF_MAX_FINE], v[CAL_MF_MAX_FINE];
-    int m = 0;
+    double d[CAL_MF_MAX_FINE][CAL_MF_MAX_Y], err[CAL_MF_MAX_FINE][CAL_MF_MAX_Y], u[CAL_MF_MAX_FINE], v[CAL_MF_MAX_FINE];
+    int m = 0, any_noisy = 0;
     for (int i = 0; i < r->n; ++i) {
         if (!measured(&r->run[i], n_y)) continue;
         double y[CAL_MF_MAX_Y];
         cal_mf_predict(cheap, r->run[i].u, r->run[i].v, y);
-        for (int k = 0; k < n_y; ++k) d[m][k] = r->run[i].y[k] - y[k];
+        for (int k = 0; k < n_y; ++k) d[m][k] = r->run[i].y[k] - y[k], err[m][k] = run_error(p, &r->run[i], k);
+        any_noisy |= noisy(p, &r->run[i]);
         u[m] = r->run[i].u, v[m] = r->run[i].v, m++;
     }
     cal_mf_correction *c = &r->correction;
@@ -254,7 +311,11 @@ static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const c
     }
     double det = suu * svv - suv * suv;
     if (use_u && use_v && !(det > 1e-12 * suu * svv)) use_u = use_v = 0; // runs on a slanted line: the mean only
-    for (int k = 0; k < n_y; ++k) {
+    for (int k = 0; k < n_y && any_noisy; ++k) weighted_plane(c, k, d, err, u, v, m, use_u, use_v);
+    // Runs of equal errors: the plain least squares on the centred coordinates
+    // (what the weighted one reduces to, kept literal: earlier calibrations
+    // re-derive bit for bit).
+    for (int k = 0; k < n_y && !any_noisy; ++k) {
         double sd = 0, sud = 0, svd = 0;
         for (int i = 0; i < m; ++i) sd += d[i][k];
         c->at[k] = sd / m;
@@ -263,7 +324,7 @@ static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const c
         else if (use_u) c->du[k] = slope(suu, sud);
         else if (use_v) c->dv[k] = slope(svv, svd);
     }
-    if (p->correction == CAL_MF_KRIGING && m >= 2) krige_residuals(c, d, u, v, m, n_y, p->run_noise);
+    if (p->correction == CAL_MF_KRIGING && m >= 2) krige_residuals(c, d, u, v, m, n_y, p->run_noise, err);
 }
 
 // One expensive run at (u, v): what the corrected map predicted there, the
@@ -272,11 +333,12 @@ static void update_correction(const cal_mf_map *cheap, cal_mf_result *r, const c
 static int run_at(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out, double u, double v)
 {
     cal_mf_point *run = &out->run[out->n];
+    memset(run, 0, sizeof *run);
     run->u = u, run->v = v;
     cal_mf_predict(cheap, u, v, out->predicted[out->n]);
     cal_mf_correct(&out->correction, p->n_y, u, v, out->predicted[out->n]);
-    if (p->run_expensive(u, v, run->y, p->ctx)) return out->failed = 1, 1;
-    out->agreed = agrees(run->y, out->predicted[out->n], p);
+    if (p->run_expensive(u, v, run, p->ctx)) return out->failed = 1, 1;
+    out->agreed = agrees(run, out->predicted[out->n], p);
     out->n++;
     update_correction(cheap, out, p);
     memset(out->delta, 0, sizeof out->delta);
@@ -294,7 +356,11 @@ int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_resul
     while (out->n < budget) {
         double u, v;
         cal_mf_optimum(cheap, &out->correction, p, &u, &v);
-        if (already_run(out, u, v)) return out->settled = 1, 0;
+        const cal_mf_point *again = already_run(out, u, v);
+        if (again) {
+            out->settled = 1, out->unmeasured = !measured(again, p->n_y), out->settled_noisy = noisy(p, again);
+            return 0;
+        }
         if (run_at(cheap, p, out, u, v)) return 0;
         if (out->agreed) return 0;
     }

@@ -23,6 +23,10 @@ enum { CAL_MF_MAX_Y = 17, CAL_MF_MAX_FINE = 64, CAL_MF_TERMS = 6 };
 typedef struct cal_mf_point {
     double u, v;
     double y[CAL_MF_MAX_Y]; ///< angle first, then the CSA at each speed
+    /// An expensive run's own error per measurement where it exceeds the
+    /// problem's run_noise (a mean that did not reach its steady state); 0:
+    /// the run_noise. Map points leave it 0.
+    double sd[CAL_MF_MAX_Y];
 } cal_mf_point;
 
 /// The map: per measurement, coefficients of 1, u, v, u², uv, v² (the last
@@ -74,10 +78,11 @@ typedef struct cal_mf_correction {
     int n_runs; ///< runs carrying kernel weights (0: the plane alone)
     double run_u[CAL_MF_MAX_FINE], run_v[CAL_MF_MAX_FINE];
     double weight[CAL_MF_MAX_Y][CAL_MF_MAX_FINE];
-    /// The kriging's scale (the residuals' rms, at least the runs' noise) and
-    /// nugget ratio per measurement, for its variance (cal_mf_correction_sd);
-    /// scale 0: no kriging (the plane alone, or a system GSL could not factor).
-    double scale[CAL_MF_MAX_Y], nugget[CAL_MF_MAX_Y];
+    /// The kriging's scale per measurement (the residuals' rms, at least the
+    /// runs' noise) and each run's nugget ratio (its noise over that scale,
+    /// squared), for its variance (cal_mf_correction_sd); scale 0: no kriging
+    /// (the plane alone, or a system GSL could not factor).
+    double scale[CAL_MF_MAX_Y], nugget[CAL_MF_MAX_Y][CAL_MF_MAX_FINE];
 } cal_mf_correction;
 
 /// Add the correction at (u, v) to y (n_y measurements); c NULL: nothing.
@@ -95,10 +100,13 @@ typedef struct cal_mf_problem {
     int n_y;
     /// What the search minimises, of a (predicted or measured) measurement vector.
     double (*objective)(const double *y, void *ctx);
-    /// Run the expensive tier at (u, v): y filled, 0 (a measurement it could
-    /// not make: NAN, and the run neither agrees nor enters the correction);
-    /// nonzero when the run could not be done at all (the loop stops).
-    int (*run_expensive)(double u, double v, double *y, void *ctx);
+    /// Run the expensive tier at (u, v): run->y filled, and run->sd where a
+    /// measurement's own error exceeds run_noise (a mean that is not steady:
+    /// it enters the correction weighed by that error, and the run cannot
+    /// agree); 0. A measurement it could not make at all: NAN, and the run
+    /// neither agrees nor enters the correction. Nonzero when the run could
+    /// not be done at all (the loop stops).
+    int (*run_expensive)(double u, double v, cal_mf_point *run, void *ctx);
     const double *noise; ///< per measurement: how far a run may be from the prediction and agree
     /// Per measurement: the expensive runs' own noise (the tier's seed spread
     /// of a candidate), which kriging smooths rather than interpolates; NULL: 0.
@@ -116,6 +124,8 @@ typedef struct cal_mf_result {
     double delta[CAL_MF_MAX_Y];              ///< that correction at the last run's point
     int agreed;                              ///< 1: the last run agreed with its prediction
     int settled;                             ///< 1: the next optimum was a point already run (stopped there)
+    int settled_noisy;                       ///< 1: settled on a run with an error of its own (not steady)
+    int unmeasured;                          ///< 1: settled on a run that measured nothing usable
     int failed;                              ///< 1: an expensive run failed
     double u_uncorrected, v_uncorrected;     ///< the cheap map's own optimum
 } cal_mf_result;

@@ -102,6 +102,15 @@ static double csa_spread(const cal_friction_result *r, int i, double tier_sd)
 
 double cal_friction_csa_spread(const cal_friction_result *r, int i) { return csa_spread(r, i, r->csa_tier_sd[i]); }
 
+int cal_candidate_run_vector(const cal_friction_result *r, const cal_candidate *k, double *y, double *sd)
+{
+    for (int j = 0; j < 1 + r->n_rpm; ++j) {
+        y[j] = j == 0 ? k->angle_deg : k->csa[j - 1], sd[j] = k->unsteady_sd[j];
+        if (!isfinite(y[j])) return 1;
+    }
+    return 0;
+}
+
 int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y)
 {
     if (!isfinite(k->angle_deg)) return 1;
@@ -134,21 +143,21 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
 typedef struct bed_mean {
     double angle, angle_sd, csa, csa_sd;
     int n_angle, n_csa;
-    double csa_unsteady; ///< the CSA over the usable runs, steady or not (NAN: none)
+    double csa_unsteady, csa_sd_unsteady; ///< the CSA and its spread over the usable runs, steady or not (NAN: none)
 } bed_mean;
 
 static bed_mean mean_over_beds(const search *s, const cal_record *rec, int j)
 {
     bed_mean m = {0};
-    double any = 0;
+    double any = 0, any_sd = 0;
     for (int b = 0; b < s->beds; ++b) {
         const cal_record *x = &rec[b * s->n_sim + j];
         if (!cal_record_usable(x)) continue;
         m.angle += x->angle_deg, m.angle_sd += x->angle_sd_deg, m.n_angle++;
-        any += x->csa_percent;
+        any += x->csa_percent, any_sd += x->csa_sd_percent;
         if (x->steady) m.csa += x->csa_percent, m.csa_sd += x->csa_sd_percent, m.n_csa++;
     }
-    m.csa_unsteady = m.n_angle ? any / m.n_angle : NAN;
+    m.csa_unsteady = m.n_angle ? any / m.n_angle : NAN, m.csa_sd_unsteady = m.n_angle ? any_sd / m.n_angle : NAN;
     m.angle = m.n_angle ? m.angle / m.n_angle : NAN, m.angle_sd = m.n_angle ? m.angle_sd / m.n_angle : NAN;
     m.csa = m.n_csa ? m.csa / m.n_csa : NAN, m.csa_sd = m.n_csa ? m.csa_sd / m.n_csa : NAN;
     return m;
@@ -160,12 +169,14 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
     cal_friction_result *r = s->r;
     bed_mean a = mean_over_beds(s, rec, s->angle_index);
     k->angle_deg = a.angle, k->angle_sd_deg = a.angle_sd;
+    k->unsteady_sd[0] = a.n_csa < a.n_angle ? a.angle_sd : 0; // a bed whose angle speed did not reach steady
     for (int i = 0; i < r->n_rpm; ++i) {
         int x = -1;
         for (int j = 0; j < s->n_sim; ++j)
             if (s->sim_rpm[j] == r->rpm[i]) x = j;
-        bed_mean m = x >= 0 ? mean_over_beds(s, rec, x) : (bed_mean){NAN, NAN, NAN, NAN, 0, 0, NAN};
+        bed_mean m = x >= 0 ? mean_over_beds(s, rec, x) : (bed_mean){NAN, NAN, NAN, NAN, 0, 0, NAN, NAN};
         k->usable[i] = m.n_csa > 0;
+        k->unsteady_sd[1 + i] = k->usable[i] ? 0 : m.csa_sd_unsteady;
         // Not usable: the unsteady runs' mean, for its misfit (squared_z) and the report.
         k->csa[i] = k->usable[i] ? m.csa : m.csa_unsteady, k->csa_sd[i] = m.csa_sd;
     }

@@ -59,15 +59,17 @@ static double map_objective(const double *y, void *ctx)
     return k.misfit + angle_penalty * over * over;
 }
 
-static int run_here(double u, double v, double *y, void *ctx)
+static int run_here(double u, double v, cal_mf_point *run, void *ctx)
 {
     two_tier *t = ctx;
     double mu_s, mu_r;
     cal_friction_to_mu(t->bounds, u, v, &mu_s, &mu_r);
     const cal_candidate *k = cal_friction_evaluate(t->search, mu_s, mu_r, "two-tier");
     if (!k) return 1;
-    if (cal_candidate_vector(t->r, k, y)) // a failed run: measured as far off as the penalty says, and not agreeing
-        for (int i = 0; i < n_measurements(t->r); ++i) y[i] = NAN;
+    // A mean that is not steady enters with its own spread (the loop weighs
+    // it by that, and it cannot agree); a failed run measured nothing.
+    if (cal_candidate_run_vector(t->r, k, run->y, run->sd))
+        for (int i = 0; i < n_measurements(t->r); ++i) run->y[i] = NAN;
     return 0;
 }
 
@@ -157,6 +159,11 @@ static const char *outcome_of(const cal_mf_result *m)
 {
     if (m->failed) return "stopped: a simulation could not be stored";
     if (m->agreed) return "agreed: the last run matched the corrected map within the data's noise";
+    if (m->settled && m->unmeasured)
+        return "stopped: the corrected optimum came back to a run that measured nothing (it failed); not settled";
+    if (m->settled && m->settled_noisy)
+        return "settled on a run that is not steady: the corrected optimum came back to it, whose mean counts "
+               "with its own spread; a longer run there would tell more";
     if (m->settled) return "settled: the corrected optimum came back to a point already run, without agreeing";
     return "stopped at max_evaluations without agreeing with the corrected map";
 }
@@ -194,9 +201,12 @@ static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap
     out->expensive_candidates = m->n, out->two_tier_outcome = loop_outcome;
     out->map_u = m->u_uncorrected, out->map_v = m->v_uncorrected;
     for (int k = 0; k < n_measurements(out); ++k) out->correction[k] = m->delta[k];
-    for (int i = 0; i < m->n; ++i)
-        fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured, %.2f° predicted by the corrected map\n", i + 1,
-                tier, m->run[i].y[0], m->predicted[i][0]);
+    for (int i = 0; i < m->n; ++i) {
+        char own[64] = "";
+        if (m->run[i].sd[0] > 0) snprintf(own, sizeof own, " (not steady: counts with ± %.2f°)", m->run[i].sd[0]);
+        fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured%s, %.2f° predicted by the corrected map\n", i + 1,
+                tier, m->run[i].y[0], own, m->predicted[i][0]);
+    }
     fprintf(stderr, "-- %s after %d run(s) at tier '%s'", out->two_tier_outcome, m->n - out->posterior_runs, tier);
     if (out->posterior_runs) fprintf(stderr, ", then %d where the posterior asked", out->posterior_runs);
     fprintf(stderr, "; correction at the last run: angle %+.2f°\n", m->delta[0]);

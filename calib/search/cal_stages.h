@@ -59,6 +59,11 @@ typedef struct cal_candidate {
     /// correction's kriging sd where it stands, in quadrature (0 for a run).
     /// The level above weighs it by this when it fits its map on this stage.
     double predicted_sd[CAL_MAX_RPM + 1];
+    /// Per measurement (angle, then CSA per speed), where the mean comes from
+    /// runs that did not reach their steady state: the spread of their series
+    /// (the error of a mean over a stationary series cannot exceed it; a drift
+    /// adds a bias beyond it). 0 for a steady measurement.
+    double unsteady_sd[CAL_MAX_RPM + 1];
     double chi2;                        ///< χ² against the data with the lab's and the tier's spreads (identification)
     int identified;                     ///< 1 if the data cannot tell it from the best χ² (Δχ² within the threshold)
     double wall_time_s;
@@ -230,6 +235,10 @@ double cal_friction_angle_spread(const cal_friction_result *r);
 /// (the order of cal_mf_point.y); 1 if a measurement is missing (failed or
 /// unsteady: not a point of any map).
 int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y);
+/// A run's measurement vector for the two-tier loop: as cal_candidate_vector,
+/// but a mean that is not steady counts, with its unsteady_sd in sd (0 for a
+/// steady one); 1 only if a measurement is missing (every run failed).
+int cal_candidate_run_vector(const cal_friction_result *r, const cal_candidate *k, double *y, double *sd);
 
 /// The same stage across two tiers (the tier's map_tier maps, the tier itself
 /// decides; cal_multifidelity.h): the cheap tier's whole search first (its

@@ -10,9 +10,18 @@
 
 #include "exp_common.h"
 
-static void on_field(void *text, size_t n, void *ctx)
+// A line being split: libcsv's callbacks fill the row, and each record it
+// ends goes to the reader's on_row.
+typedef struct splitting {
+    exp_csv_row *row;
+    exp_csv_on_row on_row;
+    void *ctx;
+    int stopped; ///< on_row returned nonzero
+} splitting;
+
+static void on_field(void *text, size_t n, void *data)
 {
-    exp_csv_row *r = ctx;
+    exp_csv_row *r = ((splitting *)data)->row;
     if (r->n < EXP_CSV_MAX_FIELDS) {
         if (n >= EXP_CSV_FIELD_CHARS) r->too_long = 1, n = EXP_CSV_FIELD_CHARS - 1;
         memcpy(r->field[r->n], text ? text : "", n);
@@ -21,7 +30,22 @@ static void on_field(void *text, size_t n, void *ctx)
     r->n++;
 }
 
-static void on_end(int terminator, void *ctx) { (void)terminator, (void)ctx; }
+static void clear_row(exp_csv_row *r)
+{
+    int at = r->line;
+    memset(r, 0, sizeof *r);
+    r->line = at;
+}
+
+// libcsv also ends a record at a lone CR (old Mac line ends), which getline
+// does not: such a line holds several rows, each its own (same line number).
+static void on_end(int terminator, void *data)
+{
+    (void)terminator;
+    splitting *s = data;
+    if (!s->stopped) s->stopped = s->on_row(s->row, s->ctx);
+    clear_row(s->row);
+}
 
 static int blank_or_comment(const char *line, int *comment)
 {
@@ -30,17 +54,17 @@ static int blank_or_comment(const char *line, int *comment)
     return *comment || *line == '\n' || *line == '\0';
 }
 
-// One line split into r; 0, or 1 with the message.
-static int split(struct csv_parser *p, const char *path, const char *line, size_t n, exp_csv_row *r, char *err,
+// One line through libcsv, each of its records to on_row; 0, or 1 with the
+// message (written here, or by on_row when it stopped).
+static int split(struct csv_parser *p, const char *path, const char *line, size_t n, splitting *s, char *err,
                  size_t len)
 {
-    int at = r->line;
-    memset(r, 0, sizeof *r);
-    r->line = at;
-    if (csv_parse(p, line, n, on_field, on_end, r) != n)
+    int at = s->row->line;
+    clear_row(s->row);
+    if (csv_parse(p, line, n, on_field, on_end, s) != n)
         return exp_fail(err, len, "%s:%d: row: malformed CSV (%s)", path, at, csv_strerror(csv_error(p)));
-    if (csv_fini(p, on_field, on_end, r) != 0) return exp_fail(err, len, "%s:%d: row: unterminated quoted field", path, at);
-    return 0;
+    if (csv_fini(p, on_field, on_end, s) != 0) return exp_fail(err, len, "%s:%d: row: unterminated quoted field", path, at);
+    return s->stopped;
 }
 
 int exp_csv_read(const char *path, exp_csv_on_row on_row, exp_csv_on_comment on_comment, void *ctx, char *err,
@@ -56,6 +80,7 @@ int exp_csv_read(const char *path, exp_csv_on_row on_row, exp_csv_on_comment on_
     size_t cap = 0;
     ssize_t n;
     int bad = 0, comment;
+    splitting s = {.row = r, .on_row = on_row, .ctx = ctx};
     while (!bad && (n = getline(&line, &cap, f)) > 0) {
         r->line++;
         // A NUL byte would end the line early for the C string checks (a line
@@ -64,7 +89,7 @@ int exp_csv_read(const char *path, exp_csv_on_row on_row, exp_csv_on_comment on_
             bad = exp_fail(err, len, "%s:%d: row: contains a NUL byte: not a text file", path, r->line);
         else if (blank_or_comment(line, &comment)) {
             if (comment && on_comment) on_comment(line, ctx);
-        } else bad = split(&p, path, line, (size_t)n, r, err, len) || on_row(r, ctx);
+        } else bad = split(&p, path, line, (size_t)n, &s, err, len);
     }
     free(line), csv_free(&p), fclose(f), free(r);
     return bad;

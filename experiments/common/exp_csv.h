@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file exp_csv.h
 /// A CSV file read the way granucal's inputs and outputs are written: one
-/// row a line, so that every message names its line; '#' comment lines and
+/// row a line, so that every message names its line (a lone CR, as in old
+/// Mac files, also ends a row, as libcsv reads it: such rows share a line); '#' comment lines and
 /// blank lines skipped (each comment handed on, for provenance lines); each
 /// line split by libcsv (its quoting and separators, strict: a stray quote
 /// or a quote left open at the end of the line is an error). The schema

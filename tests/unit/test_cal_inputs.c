@@ -88,6 +88,9 @@ static void test_bad_csv_named_by_line_and_field(void **state)
     snprintf(text, sizeof text, "%sPP,4,45", header), expect_csv_error(text, 2, "row");         // truncated
     expect_csv_error(header, 1, "row");                                      // no data
     snprintf(text, sizeof text, "%sPP,4,1e999,1\n", header), expect_csv_error(text, 2, "csa_percent"); // overflow
+    // A lone CR ends a row (libcsv), so it cannot join two half rows into one
+    // of 4 fields (found by fuzz_csv, CI stop 46).
+    snprintf(text, sizeof text, "%sPP,105\r55.93,1.60\n", header), expect_csv_error(text, 2, "row");
 }
 
 static void test_quoted_and_commented_csv_reads(void **state)
@@ -552,6 +555,15 @@ static void test_friction_rule(void **state)
     for (int k = 0; k < 2; ++k) cal_candidate_score(&r, &r.cand[k]);
     assert_true(fabs(r.cand[1].misfit - (100 + 25) / 3.0) < 1e-9);
     assert_int_equal(cal_friction_best(&r), 0);
+    // The unsteady candidate is not a point of any map, but its run measured: the two-tier loop
+    // takes its value with its own spread. A failed speed (no value) measured nothing.
+    double y[4], sd[4];
+    r.cand[1].unsteady_sd[2] = 1.3;
+    assert_int_equal(cal_candidate_vector(&r, &r.cand[1], y), 1);
+    assert_int_equal(cal_candidate_run_vector(&r, &r.cand[1], y, sd), 0);
+    assert_true(y[0] == 42.20 && y[2] == 60 && sd[0] == 0 && sd[2] == 1.3 && sd[3] == 0);
+    r.cand[1].csa[1] = NAN;
+    assert_int_equal(cal_candidate_run_vector(&r, &r.cand[1], y, sd), 1);
 }
 
 // The identified ranges (cal_friction_identify). First by hand: one speed,

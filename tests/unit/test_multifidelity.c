@@ -52,11 +52,11 @@ static double objective(const double *y, void *ctx)
     return sum / N_Y;
 }
 
-static int run_expensive(double u, double v, double *y, void *ctx)
+static int run_expensive(double u, double v, cal_mf_point *run, void *ctx)
 {
     twin *t = ctx;
     if (++t->runs == t->fail_at) return 1;
-    expensive_response(u, v, y);
+    expensive_response(u, v, run->y);
     return 0;
 }
 
@@ -110,7 +110,7 @@ static void a_quadratic_is_fitted_exactly(void **state)
 static void too_few_points_are_refused(void **state)
 {
     (void)state;
-    cal_mf_point pts[2] = {{0.1, 0.1, {1, 2, 3}}, {0.9, 0.9, {2, 3, 4}}};
+    cal_mf_point pts[2] = {{.u = 0.1, .v = 0.1, .y = {1, 2, 3}}, {.u = 0.9, .v = 0.9, .y = {2, 3, 4}}};
     cal_mf_map map;
     assert_int_equal(cal_mf_fit(pts, 2, N_Y, &map), 1);
 }
@@ -243,10 +243,10 @@ static double bound_objective(const double *y, void *ctx)
     (void)ctx;
     return (y[0] - 34.6) * (y[0] - 34.6) / 0.25 + (y[1] - 48.0) * (y[1] - 48.0);
 }
-static int bound_run(double u, double v, double *y, void *ctx)
+static int bound_run(double u, double v, cal_mf_point *run, void *ctx)
 {
     ++*(int *)ctx;
-    bound_expensive(u, v, y);
+    bound_expensive(u, v, run->y);
     return 0;
 }
 
@@ -350,6 +350,91 @@ static void runs_after_the_loop_go_where_asked_and_correct_the_map(void **state)
     assert_int_equal(t.runs, 3);
 }
 
+// An expensive run that is biased by offset[i] on its i-th call (all
+// measurements), with its own error sd[i] (0: steady), or measures nothing.
+typedef struct scripted {
+    double offset[4], sd[4];
+    int nothing, runs;
+} scripted;
+
+static int scripted_run(double u, double v, cal_mf_point *run, void *ctx)
+{
+    scripted *s = ctx;
+    int i = s->runs++;
+    expensive_response(u, v, run->y);
+    for (int k = 0; k < N_Y; ++k) run->y[k] = s->nothing ? NAN : run->y[k] + s->offset[i], run->sd[k] = s->sd[i];
+    return 0;
+}
+
+static const double tier_noise[N_Y] = {0.25, 0.25, 0.25};
+
+static cal_mf_problem scripted_problem(scripted *s, int budget, cal_mf_correction_kind kind)
+{
+    cal_mf_problem p = problem_of(NULL, budget);
+    p.run_expensive = scripted_run, p.run_noise = tier_noise, p.ctx = s, p.correction = kind;
+    return p;
+}
+
+// A run that is not steady measures, but cannot agree: where the map is
+// exact, the steady run agrees at once; the same run with its own spread
+// does not, and the loop, whose correction it leaves at 0, comes back to it
+// and says so. A run that measures nothing is never called settled.
+static void a_run_not_steady_cannot_agree_and_one_unmeasured_is_not_settled(void **state)
+{
+    (void)state;
+    twin exact = TWIN(0, 0, 0, 0, 0, 0);
+    cal_mf_map map;
+    map_of(&exact, 4, &map);
+    cal_mf_result r;
+    scripted steady = {{0}, {0}, 0, 0}, unsteady = {{0}, {3.0}, 0, 0}, nothing = {{0}, {0}, 1, 0};
+    cal_mf_problem p = scripted_problem(&steady, 4, CAL_MF_KRIGING);
+    cal_mf_search(&map, &p, &r);
+    assert_true(r.agreed), assert_int_equal(r.n, 1);
+    p = scripted_problem(&unsteady, 4, CAL_MF_KRIGING);
+    cal_mf_search(&map, &p, &r);
+    assert_false(r.agreed), assert_int_equal(r.n, 1);
+    assert_true(r.settled && r.settled_noisy && !r.unmeasured);
+    p = scripted_problem(&nothing, 4, CAL_MF_KRIGING);
+    cal_mf_search(&map, &p, &r);
+    assert_false(r.agreed), assert_int_equal(r.n, 1);
+    assert_true(r.settled && r.unmeasured);
+}
+
+// Two runs, a steady one 9 below the map and one not steady (its own spread
+// 5, the tier's noise 0.25) 3 below: the affine correction's mean weighs them
+// by 1/error², (-9·16 - 3·0.04) / 16.04, not the plain -6; kriging then pulls
+// the correction only part of the way to the unsteady run's -3 and keeps
+// more of its own variance there than at the steady run.
+static void a_run_not_steady_counts_by_its_own_spread(void **state)
+{
+    (void)state;
+    twin exact = TWIN(0, 0, 0, 0, 0, 0);
+    cal_mf_map map;
+    map_of(&exact, 4, &map);
+    const double weighted = (-9 / (0.25 * 0.25) - 3 / 25.0) / (1 / (0.25 * 0.25) + 1 / 25.0);
+    for (int kind = 0; kind < 2; ++kind) {
+        scripted s = {{-9, -3}, {0, 5}, 0, 0};
+        cal_mf_problem p = scripted_problem(&s, 0, kind ? CAL_MF_AFFINE : CAL_MF_KRIGING);
+        cal_mf_result r;
+        cal_mf_search(&map, &p, &r);
+        asks a = {{0.2, 0.8}, {0.5, 0.5}, 2, 0};
+        cal_mf_refine(&map, &p, 2, next_of_list, &a, &r);
+        assert_int_equal(r.n, 2);
+        assert_false(r.agreed);
+        double at_a[N_Y] = {0}, at_b[N_Y] = {0};
+        cal_mf_correct(&r.correction, N_Y, 0.2, 0.5, at_a), cal_mf_correct(&r.correction, N_Y, 0.8, 0.5, at_b);
+        printf("%s: correction %.4f at the steady run, %.4f at the unsteady one (plane mean %.4f)\n",
+               kind ? "affine" : "kriging", at_a[0], at_b[0], r.correction.at[0]);
+        for (int k = 0; k < N_Y; ++k) {
+            assert_float_equal(r.correction.at[k], weighted, 1e-9);
+            if (kind) continue;
+            assert_float_equal(at_a[k], -9, 0.05);
+            assert_true(at_b[k] > weighted + 1 && at_b[k] < -3 - 1);
+            assert_true(cal_mf_correction_sd(&r.correction, k, 0.8, 0.5) > 10 * cal_mf_correction_sd(&r.correction, k, 0.2, 0.5));
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -362,6 +447,8 @@ int main(void)
         cmocka_unit_test(a_curved_bias_along_mu_r_is_followed),
         cmocka_unit_test(a_failed_run_stops_the_loop),
         cmocka_unit_test(runs_after_the_loop_go_where_asked_and_correct_the_map),
+        cmocka_unit_test(a_run_not_steady_cannot_agree_and_one_unmeasured_is_not_settled),
+        cmocka_unit_test(a_run_not_steady_counts_by_its_own_spread),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

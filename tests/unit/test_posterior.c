@@ -81,7 +81,7 @@ static void test_kriging_sd_is_the_nugget_at_a_run_and_the_scale_far_away(void *
     // scale² (1 - kᵀK⁻¹k) = 0 up to the nugget; far from both, scale.
     cal_mf_correction c = {0};
     c.n_runs = 2, c.run_u[0] = 0.25, c.run_v[0] = 0.5, c.run_u[1] = 0.75, c.run_v[1] = 0.5;
-    c.scale[0] = 2, c.nugget[0] = 1e-9;
+    c.scale[0] = 2, c.nugget[0][0] = c.nugget[0][1] = 1e-9;
     assert_float_equal(cal_mf_correction_sd(&c, 0, 0.25, 0.5), 0, 1e-3);
     assert_float_equal(cal_mf_correction_sd(&c, 0, 0.5, 5.0), 2, 1e-9);
     // Between the runs: k = exp(-0.25²/(2·0.25²)) = e^-0.5 each; K = [[1, e^-2], [e^-2, 1]]:
@@ -99,7 +99,8 @@ static void kriging_at(cal_friction_result *r, const double *u, const double *v,
     memset(&r->discrepancy, 0, sizeof r->discrepancy);
     r->discrepancy.n_runs = n;
     for (int i = 0; i < n; ++i) r->discrepancy.run_u[i] = u[i], r->discrepancy.run_v[i] = v[i];
-    r->discrepancy.scale[0] = scale, r->discrepancy.nugget[0] = 1e-9;
+    r->discrepancy.scale[0] = scale;
+    for (int i = 0; i < n; ++i) r->discrepancy.nugget[0][i] = 1e-9;
 }
 
 static void a_run_is_asked_only_where_the_map_holds_the_posterior_wide(void **state)
