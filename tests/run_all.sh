@@ -17,7 +17,14 @@ jobs=$(nproc)
 # Each phase's wall time, printed at the end (what CI's total is made of).
 phase_start=$(date +%s) phases=""
 phase_done() { local now; now=$(date +%s); phases+="$(printf '%-28s %5d s' "$1" $((now - phase_start)))"$'\n'; phase_start=$now; }
-trap 'printf "run_all.sh phases (wall):\n%s" "$phases"' EXIT
+# And the Release pass's slowest tests (CI shows only the end of the log): where its time went.
+release_log=build/release-tests.log
+slowest() {
+  [ -f "$release_log" ] || return 0
+  echo "run_all.sh: the Release pass's 15 slowest tests (wall s, two at a time):"
+  grep -E "Test +#[0-9]+: " "$release_log" | sed -E 's/.*Test +#[0-9]+: ([^ ]+) .* ([0-9.]+) sec$/\2 \1/' | sort -rn | head -15
+}
+trap 'slowest; printf "run_all.sh phases (wall):\n%s" "$phases"' EXIT
 bash .ci/setup
 phase_done "setup and Release build"
 # Every Release test in one pass, two at a time, so that a long test on one core (the standard
@@ -27,7 +34,8 @@ phase_done "setup and Release build"
 # committed store and compared with Table 3 (results/calibration-standard/README.md; the earlier affine
 # run, results/calibration-standard-affine/, re-derived and compared). Label table3_full (the ci twin
 # made afresh, 15-28 min) is run by hand: CI verifies the committed twin from its stores instead.
-ctest --test-dir build --output-on-failure -j"$jobs" -LE "^table3_full$"
+rm -f "$release_log"
+ctest --test-dir build --output-on-failure -j"$jobs" -LE "^table3_full$" | tee "$release_log"
 phase_done "Release tests (table3 too)"
 # Without MPI: OpenMPI's MPI_Init loads components whose thread-local storage crashes
 # LeakSanitizer's tracer at exit (every granucal calibrate under ASan ended in "Tracer caught
