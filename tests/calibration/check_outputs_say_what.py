@@ -27,15 +27,20 @@ def bounds(run_dir):
     return {(block, k): float(v) for block in ('granule', 'wall') for k, v in config[block].items()}
 
 
+def reaches_bounds(parameter, lo, hi, lo_bound, hi_bound):
+    """Whether an interval [lo, hi] runs to within 3 % of the search range (mu_r in log10) of each bound:
+    (reaches the lower, reaches the upper). Also twin_coverage.py's rule."""
+    unit = math.log10 if parameter == 'mu_r' else (lambda x: x)
+    span = unit(hi_bound) - unit(lo_bound)
+    return ((unit(lo) - unit(lo_bound)) / span <= 0.03 + 1e-6, (unit(hi_bound) - unit(hi)) / span <= 0.03 + 1e-6)
+
+
 def outside_credible(r, v, lo_bound, hi_bound, outside):
     """Outside the posterior's 95 % credible interval, and not beyond an end that reaches its bound."""
     if r.get('credible_min', '') == '':
         return False
     clo, chi = float(r['credible_min']), float(r['credible_max'])
-    unit = (lambda x: math.log10(x)) if r['parameter'] == 'mu_r' else (lambda x: x)
-    span = unit(hi_bound) - unit(lo_bound)
-    reaches_lower = (unit(clo) - unit(lo_bound)) / span <= 0.03 + 1e-6
-    reaches_upper = (unit(hi_bound) - unit(chi)) / span <= 0.03 + 1e-6
+    reaches_lower, reaches_upper = reaches_bounds(r['parameter'], clo, chi, lo_bound, hi_bound)
     if not outside(clo, chi):
         return False
     return not ((v > chi and reaches_upper) or (v < clo and reaches_lower))

@@ -11,9 +11,12 @@
 # Prints a Markdown table (friction, truth, value, status, interval, covered, told, narrowed) and exits
 # 1 when a friction is not covered, or is told but not narrowed.
 #   usage: twin_coverage.py RESULTS_DIR [--report-only]
-import csv, math, re, sys
+import csv, os, re, sys
 
 import yaml  # python3-yaml (.ci/setup)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_outputs_say_what import reaches_bounds  # noqa: E402  (one home for the 3 % rule)
 
 
 def truths(results):
@@ -59,10 +62,7 @@ def main():
             continue
         lo, hi = float(r["credible_min"]), float(r["credible_max"])
         b = config["wall" if r["material"] else "granule"]
-        unit = math.log10 if p == "mu_r" else (lambda x: x)
-        span = unit(b[p + "_max"]) - unit(b[p + "_min"])
-        reaches_both = (unit(lo) - unit(b[p + "_min"])) / span <= 0.03 + 1e-6 and \
-                       (unit(b[p + "_max"]) - unit(hi)) / span <= 0.03 + 1e-6
+        reaches_both = all(reaches_bounds(p, lo, hi, float(b[p + "_min"]), float(b[p + "_max"])))
         covered = lo * (1 - 1e-6) <= t <= hi * (1 + 1e-6)
         tells = can_tell.get(r["material"], {}).get(p, False)
         narrowed = not reaches_both
