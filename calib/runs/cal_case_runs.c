@@ -349,6 +349,17 @@ typedef struct heartbeat {
     exp_progress_printer printer; ///< prints label; keep the heartbeat where it was started
 } heartbeat;
 
+// A simulation's progress: cores the pool has granted since it started are
+// taken here, between two samples (cal_pool.h), then the heartbeat.
+static void run_progress(const char *phase, double t, size_t granules, void *printer)
+{
+    int now = cal_pool_take_granted_cores();
+    if (now)
+        fprintf(stderr, "%s: %s t = %.4f s: on %d threads from here (the batch's other runs have ended)\n",
+                ((const exp_progress_printer *)printer)->scene, phase, t, now);
+    exp_print_progress(phase, t, granules, printer);
+}
+
 static void heartbeat_start(heartbeat *h, const char *stage, const char *what)
 {
     snprintf(h->label, sizeof h->label, "[%s] %s", stage, what);
@@ -370,7 +381,7 @@ static dem_world *pour_bed(const cal_env *env, const exp_drum_def *fill, double 
     double t0 = exp_wall_seconds();
     heartbeat h;
     heartbeat_of_bed(&h, env->stage, fill);
-    dem_world *bed = exp_drum_fill(fill, exp_print_progress, &h.printer, err, len);
+    dem_world *bed = exp_drum_fill(fill, run_progress, &h.printer, err, len);
     *wall_s = exp_wall_seconds() - t0;
     return bed;
 }
@@ -398,7 +409,7 @@ static int turn_and_store(drum_batch *b, dem_world *bed, drum_run r, double fill
     checkpoint_path(b->env, key, ck_path, sizeof ck_path);
     exp_drum_turn turn = {.def = &c->def, .run = cal_drum_run_opts(c, b->rpm[r.k]), .checkpoint_path = ck_path,
                           .key = key, .checkpoint_every_s = b->env->checkpoint_every_s,
-                          .progress = exp_print_progress, .log_prefix = prefix};
+                          .progress = run_progress, .log_prefix = prefix};
     snprintf(prefix, sizeof prefix, "[%s]", b->env->stage);
     snprintf(what, sizeof what, "%g rpm, seed %llu", turn.run.rpm, (unsigned long long)c->def.seed);
     heartbeat h;
@@ -559,7 +570,7 @@ static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, do
     heartbeat_start(&h, env->stage, what);
     exp_drum_turn turn = {.def = &c->start, .run = start_turn_opts(c, rpm), .checkpoint_path = path, .key = key,
                           .checkpoint_every_s = env->checkpoint_every_s, .checkpoint_at_end = 1,
-                          .progress = exp_print_progress, .progress_ctx = &h.printer, .log_prefix = prefix};
+                          .progress = run_progress, .progress_ctx = &h.printer, .log_prefix = prefix};
     dem_status st;
     exp_drum_turn_bed(bed, 1, &turn, res, &st);
     if (st == DEM_OK) return bed;

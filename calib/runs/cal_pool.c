@@ -39,6 +39,47 @@ static void die_with_parent(pid_t parent)
 /// the engine sums each granule's forces in one order on any number of threads.
 static int threads_each(int n, int workers) { return n < workers ? workers / n : 1; }
 
+// Cores freed later go the same way. When a worker ends with no task left to
+// start, its core idles while the others run on (a batch's last long run: a
+// 4 rpm drum that MSER keeps turning long after its 40 and 116 rpm runs have
+// ended); the parent then tells each running worker its new share,
+// workers / running, by a queued real-time signal whose value is that share,
+// and the worker takes it between two of its steps (cal_pool_take_granted_cores;
+// a signal handler must not call OpenMP). The handler is installed before the
+// fork, so a worker can never receive the signal before it can handle it.
+#define GRANT_SIGNAL SIGRTMIN
+static volatile sig_atomic_t granted_threads; ///< in a worker: the share the parent last granted; 0 none
+
+static void on_grant(int sig, siginfo_t *info, void *uc)
+{
+    (void)sig, (void)uc;
+    granted_threads = info->si_value.sival_int;
+}
+
+int cal_pool_take_granted_cores(void)
+{
+#ifdef _OPENMP
+    int share = granted_threads;
+    if (share <= omp_get_max_threads()) return 0;
+    omp_set_num_threads(share);
+    return share;
+#else
+    return 0;
+#endif
+}
+
+// After a worker ended: with nothing left to start, each running worker's
+// share of the cores, told to those it grows for. threads[i]: task i's now.
+static void grant_idle_cores(const pid_t *pids, int *threads, int n, int running, int workers)
+{
+    if (running <= 0) return;
+    int share = workers / running;
+    for (int i = 0; i < n; ++i)
+        if (pids[i] > 0 && share > threads[i] &&
+            sigqueue(pids[i], GRANT_SIGNAL, (union sigval){.sival_int = share}) == 0)
+            threads[i] = share;
+}
+
 static int exit_code_of(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status); }
 
 int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int workers, int use_fork)
@@ -46,15 +87,20 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
     if (!use_fork || n <= 0) return run_inline(n, task, done, ctx);
     if (workers < 1) workers = 1;
     pid_t *pids = calloc((size_t)n, sizeof *pids);
-    if (!pids) return run_inline(n, task, done, ctx);
+    int *threads = calloc((size_t)n, sizeof *threads);
+    if (!pids || !threads) return free(pids), free(threads), run_inline(n, task, done, ctx);
     int next = 0, running = 0, failures = 0;
     fflush(NULL); // no buffered output duplicated into the children
     const pid_t parent = getpid();
+    struct sigaction grant = {.sa_sigaction = on_grant, .sa_flags = SA_SIGINFO | SA_RESTART}, before;
+    sigemptyset(&grant.sa_mask);
+    sigaction(GRANT_SIGNAL, &grant, &before);
     while (next < n || running > 0) {
         while (running < workers && next < n) {
             pid_t pid = fork();
             if (pid == 0) {
                 die_with_parent(parent);
+                granted_threads = 0;
 #ifdef _OPENMP
                 omp_set_num_threads(threads_each(n, workers)); // the parent runs on one (cal_cmd_calibrate.c)
 #endif
@@ -64,7 +110,7 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
                 int code = task(next, ctx);
                 failures += code != 0;
                 if (done) done(next, code, ctx);
-            } else pids[next] = pid, running++;
+            } else pids[next] = pid, threads[next] = threads_each(n, workers), running++;
             next++;
         }
         int status;
@@ -77,7 +123,9 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
                 failures += code != 0;
                 if (done) done(i, code, ctx);
             }
+        if (next == n) grant_idle_cores(pids, threads, n, running, workers);
     }
-    free(pids);
+    sigaction(GRANT_SIGNAL, &before, NULL);
+    free(pids), free(threads);
     return failures;
 }

@@ -5,7 +5,9 @@
 /// one failed simulation, not a lost calibration. Without fork (under MPI,
 /// where forking is unsafe) they run one after the other in this process.
 /// A batch of fewer simulations than workers gives each the idle workers'
-/// cores as OpenMP threads (the same results on any number of threads).
+/// cores as OpenMP threads (the same results on any number of threads), and
+/// so does a batch whose last tasks run on after the others have ended: a
+/// worker's core, once nothing is left to start, goes to those still running.
 #ifndef CAL_POOL_H
 #define CAL_POOL_H
 
@@ -18,5 +20,12 @@ typedef void (*cal_done_fn)(int i, int code, void *ctx);
 /// Run tasks[0..n) with up to `workers` processes. Returns the number of
 /// tasks that did not end with 0.
 int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int workers, int use_fork);
+
+/// In a task (a forked worker): take the cores the pool has granted it since
+/// it started, as OpenMP threads for the parallel regions to come. Call it
+/// between parallel regions, as a simulation's progress does between two
+/// samples. Returns the threads it runs on from now if this call added some,
+/// else 0 (nothing granted since, or not a worker).
+int cal_pool_take_granted_cores(void);
 
 #endif
