@@ -23,7 +23,8 @@ int cal_default_jobs(void)
 cal_option cal_option_jobs(int *jobs)
 {
     return (cal_option){.name = "jobs", .kind = CAL_OPT_INT, .integer = jobs, .lo = 1, .hi = 1024, .value = "N",
-                        .help = "simulations side by side on this machine (default: its cores)"};
+                        .help = "cores this run may use (default: all): simulations side by side, one thread each, "
+                                "an idle core a thread of one that runs; two jobs on one machine: give each its share"};
 }
 
 cal_option cal_option_out(const char **out, const char *help)
