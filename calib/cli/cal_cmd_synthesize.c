@@ -44,8 +44,12 @@ static const char synopsis[] =
     "The files say SYNTHETIC in their header with the command, version and seeds.\n";
 
 static const char epilogue[] =
-    "Each value is the mean over the seeds whose run is usable; its spread column is the\n"
-    "standard error of that mean (sd over seeds / sqrt(n)), floored at 0.05.\n";
+    "Each value is the mean over the seeds whose run is steady; its spread column is the\n"
+    "standard error of that mean (sd over seeds / sqrt(n)), floored at 0.05. Where no seed\n"
+    "reached a steady state by max_time (a bed that avalanches), the value is the mean of\n"
+    "the runs that did not, its spread at least their series' mean spread (the error of\n"
+    "each mean cannot exceed it), and a '# Not steady:' line in the file names the point.\n"
+    "Only a point whose every run failed stops the synthesis.\n";
 
 typedef struct pair {
     char name[32];
@@ -212,11 +216,15 @@ static cal_drum_case case_of(const job *j, const lining *l, long seed)
 typedef struct summary {
     double mean, se;
     int n;
+    /// No seed reached a steady state here: the mean is over the runs that
+    /// did not, and `series` is the mean spread of their series over the
+    /// averaging window, an upper bound of each mean's error (0: steady).
+    double series;
 } summary;
 
 static summary summarise(const double *v, int n)
 {
-    summary s = {NAN, NAN, n};
+    summary s = {NAN, NAN, n, 0};
     if (n == 0) return s;
     double sum = 0, sq = 0;
     for (int i = 0; i < n; ++i) sum += v[i];
@@ -278,15 +286,28 @@ static int make_lining(job *j, const lining *l, lining_result *out)
     if (cal_drum_evaluate_many(&j->env, cases, n, j->rpm, j->n_rpm, rec, j->err, sizeof j->err)) return free(rec), 1;
     int bad = 0;
     for (int k = 0; k < j->n_rpm; ++k) {
-        double angle[MAX_SEEDS], csa[MAX_SEEDS];
-        int m = 0;
-        for (int s = 0; s < n; ++s) {
-            const cal_record *r = &rec[s * j->n_rpm + k];
-            if (cal_record_usable(r) && r->steady && isfinite(r->angle_deg)) angle[m] = r->angle_deg, csa[m++] = r->csa_percent;
+        // The steady seeds; where none is, those that ran but did not settle, with their spreads (a
+        // calibration's two-tier loop counts such a run the same way: cal_multifidelity.h).
+        for (int steady = 1; steady >= 0; --steady) {
+            double angle[MAX_SEEDS], csa[MAX_SEEDS], angle_sd = 0, csa_sd = 0;
+            int m = 0;
+            for (int s = 0; s < n; ++s) {
+                const cal_record *r = &rec[s * j->n_rpm + k];
+                if (!cal_record_usable(r) || !isfinite(r->angle_deg) || (steady && !r->steady)) continue;
+                angle[m] = r->angle_deg, csa[m++] = r->csa_percent;
+                angle_sd += r->angle_sd_deg, csa_sd += r->csa_sd_percent;
+            }
+            out->angle[k] = summarise(angle, m), out->csa[k] = summarise(csa, m);
+            if (m && !steady) {
+                out->angle[k].series = angle_sd / m, out->csa[k].series = csa_sd / m;
+                fprintf(stderr, "-- %s at %g rpm: no seed reached a steady state; its data are the mean of %d run(s) "
+                                "that did not, spread %.2f° and %.2f %% (their series' spread)\n",
+                        l->surface, j->rpm[k], m, out->angle[k].series, out->csa[k].series);
+            }
+            if (m) break;
         }
-        out->angle[k] = summarise(angle, m), out->csa[k] = summarise(csa, m);
-        if (m == 0 && !bad)
-            bad = exp_fail(j->err, sizeof j->err, "%s at %g rpm: no seed reached a steady state (see %s/store)", l->surface,
+        if (out->angle[k].n == 0 && !bad)
+            bad = exp_fail(j->err, sizeof j->err, "%s at %g rpm: every seed's run failed (see %s/store)", l->surface,
                            j->rpm[k], j->out);
     }
     for (int i = 0; i < n * j->n_rpm; ++i) cal_record_free(&rec[i]);
@@ -294,9 +315,13 @@ static int make_lining(job *j, const lining *l, lining_result *out)
     return bad;
 }
 
-static double spread_of(summary s) { return isfinite(s.se) ? fmax(s.se, 0.05) : 0.05; }
+static double spread_of(summary s)
+{
+    double se = isfinite(s.se) ? fmax(s.se, 0.05) : 0.05;
+    return fmax(se, s.series);
+}
 
-static void write_header(FILE *f, const job *j, const char *what, const char *command)
+static void write_header(FILE *f, const job *j, const lining_result *res, const char *what, const char *command)
 {
     fprintf(f, "# SYNTHETIC - not lab data. %s made by the drum of tier '%s' (lambda %g, %s, max_time %g s)\n", what,
             j->t->name, j->t->lambda, j->t->slice_depth > 0 ? "periodic slice" : "full drum", j->t->max_time);
@@ -307,7 +332,14 @@ static void write_header(FILE *f, const job *j, const char *what, const char *co
         fprintf(f, ", %s mu_s %g mu_r %g", j->opt.walls[i].name, j->opt.walls[i].mu_s, j->opt.walls[i].mu_r);
     fprintf(f, ".\n# Mean over the usable runs of seeds");
     for (int s = 0; s < j->opt.n_seeds; ++s) fprintf(f, "%s%ld", s ? "," : " ", j->opt.seeds[s]);
-    fprintf(f, "; spread = standard error of that mean (floor 0.05).\n# Made by: %s\n", command);
+    fprintf(f, "; spread = standard error of that mean (floor 0.05).\n");
+    for (int l = 0; l < j->n_linings; ++l)
+        for (int k = 0; k < j->n_rpm; ++k)
+            if (res[l].angle[k].series > 0)
+                fprintf(f, "# Not steady: %s at %g rpm (no seed reached the tier's standard error by max_time): the mean of "
+                           "the runs that did not, spread the larger of that error and their series' mean spread.\n",
+                        j->linings[l].surface, j->rpm[k]);
+    fprintf(f, "# Made by: %s\n", command);
 }
 
 // One data file: the angle at the angle's speed, or the CSA at every speed
@@ -318,7 +350,7 @@ static int write_series(job *j, const lining_result *res, const char *command, i
     exp_atomic_file a;
     snprintf(path, sizeof path, "%s/%s", j->out, angle ? "repose_angle.csv" : "occupied_area.csv");
     if (exp_atomic_open(&a, path, j->err, sizeof j->err)) return 1;
-    write_header(a.f, j, angle ? "Dynamic angle of repose" : "Occupied cross-section area (eq. 20)", command);
+    write_header(a.f, j, res, angle ? "Dynamic angle of repose" : "Occupied cross-section area (eq. 20)", command);
     fputs(angle ? "surface,rpm,angle_deg,angle_sd_deg\n" : "surface,rpm,csa_percent,csa_sd_percent\n", a.f);
     for (int l = 0; l < j->n_linings; ++l)
         for (int k = 0; k < j->n_rpm; ++k) {
