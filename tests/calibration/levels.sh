@@ -22,14 +22,10 @@ python3 - "$work" configs/calibration.yaml <<'PY'
 import csv, re, sys
 work, config = sys.argv[1], sys.argv[2]
 levels = [("PTFE (map 2)", "check"), ("PTFE (map)", "check-two-tier"), ("PTFE", "check-levels")]
-fails = []
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok: fails.append(what)
+sys.path.insert(0, "tests/calibration")
+from checks import check, finish, tier_int  # noqa: E402
 
-# The top tier's max_evaluations, from its block of the config.
-block = re.search(r"^  - name: check-levels\n((?:    .*\n|\s*#.*\n)*)", open(config).read(), re.M).group(1)
-max_evaluations = int(re.search(r"^    max_evaluations: (\d+)", block, re.M).group(1))
+max_evaluations = tier_int(config, "check-levels", "max_evaluations")  # the top tier's
 
 plan = open(f"{work}/plan.log").read()
 for label, tier in levels:
@@ -68,5 +64,5 @@ for n, (label, tier) in enumerate(levels, 1):
     check(costed is not None and int(costed.group(1)) == runs and int(costed.group(2)) == sims
           and abs(float(costed.group(3)) - core_h) < 0.006,
           f"report.md's cost table: tier '{tier}' with its {runs} runs, {sims} simulations and core-hours")
-sys.exit(1 if fails else 0)
+finish()
 PY

@@ -28,14 +28,11 @@ run none "$work/none.yaml" "$work/none"
 python3 - "$work" configs/calibration.yaml <<'PY'
 import csv, re, sys
 work, config = sys.argv[1], sys.argv[2]
-fails = []
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok: fails.append(what)
+sys.path.insert(0, "tests/calibration")
+from checks import check, finish, tier_int  # noqa: E402
 
-block = re.search(r"^  - name: check-posterior\n((?:    .*\n|\s*#.*\n)*)", open(config).read(), re.M).group(1)
-max_evaluations = int(re.search(r"^    max_evaluations: (\d+)", block, re.M).group(1))
-posterior_runs = int(re.search(r"^    posterior_runs: (\d+)", block, re.M).group(1))
+max_evaluations = tier_int(config, "check-posterior", "max_evaluations")
+posterior_runs = tier_int(config, "check-posterior", "posterior_runs")
 
 def deciding_pairs(out):
     with open(f"{out}/simulations.csv") as f:
@@ -71,6 +68,5 @@ none = open(f"{work}/none.log").read()
 check(" 0 simulations run now" in none, "posterior_runs: 0 re-derives from the same store with 0 simulations")
 check(len(deciding_pairs(f"{work}/none")) == loop_runs, f"posterior_runs: 0 keeps the loop's {loop_runs} runs alone")
 check("After the loop" not in open(f"{work}/none/report.md").read(), "posterior_runs: 0: no word of runs after the loop")
-print(f"{len(fails)} failure(s)")
-sys.exit(1 if fails else 0)
+finish()
 PY
