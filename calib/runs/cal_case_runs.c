@@ -608,9 +608,7 @@ static dem_world *settled_bed(cal_env *env, const exp_drum_def *fill, double *wa
     *wall_s = 0;
     if (env->kept_bed && strcmp(text, env->kept_text) == 0) return env->kept_bed;
     release_kept_bed(env);
-    int had = cal_pool_alone_begin(env->workers, env->use_fork); // no worker runs while the parent pours
     env->kept_bed = pour_bed(env, fill, wall_s, err, len);
-    cal_pool_alone_end(had);
     if (env->kept_bed) snprintf(env->kept_text, sizeof env->kept_text, "%s", text);
     return env->kept_bed;
 }
@@ -701,13 +699,11 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
     if (!t) {
         double fill_s;
         exp_drum_result res;
-        // No worker runs while the parent makes it: it takes their cores as threads. On the quiet
-        // 2-core machine a λ 1000 bed turns at 4 rpm 1.39x faster on 2 threads than on 1
-        // (results/benchmarks/threads_2core/); the 241 s of wall a simulated second once seen on 2
-        // threads was measured beside another calibration's workers, which no --jobs covers.
-        int had = cal_pool_alone_begin(env->workers, env->use_fork);
+        // On the parent's one thread (cal_pool.c): given the idle workers' cores as OpenMP threads, a
+        // λ 1000 bed turned at 241 s of wall a simulated second on this 2-core machine, where one thread
+        // a run took 91-179 (median ~110; the 12 λ 1000 4 rpm records of
+        // results/calibration-standard-kriging/, same k_n, two runs side by side).
         dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
-        cal_pool_alone_end(had);
         if (!bed) return write_failed(env, run_key(b, r), err), NULL;
         // A file made by an earlier process was charged there; one made now by a worker, here.
         double turn_s = res.wall_time_s - (listed_hash(b->prepped, b->n_prep, hash) ? 0 : res.earlier_wall_s);

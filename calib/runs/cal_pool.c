@@ -68,27 +68,6 @@ int cal_pool_take_granted_cores(void)
 #endif
 }
 
-int cal_pool_alone_begin(int workers, int use_fork)
-{
-#ifdef _OPENMP
-    int had = omp_get_max_threads();
-    if (use_fork && workers > had) omp_set_num_threads(workers);
-    return had;
-#else
-    (void)workers, (void)use_fork;
-    return 1;
-#endif
-}
-
-void cal_pool_alone_end(int had)
-{
-#ifdef _OPENMP
-    omp_set_num_threads(had);
-#else
-    (void)had;
-#endif
-}
-
 // After a worker ended: with nothing left to start, each running worker's
 // share of the cores, told to those it grows for. threads[i]: task i's now.
 static void grant_idle_cores(const pid_t *pids, int *threads, int n, int running, int workers)

@@ -28,12 +28,4 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
 /// else 0 (nothing granted since, or not a worker).
 int cal_pool_take_granted_cores(void);
 
-/// This process is about to run a simulation while no worker runs (a
-/// calibration's parent pouring or turning the one bed a batch starts from):
-/// with forked workers (use_fork), it takes every worker's core as a thread,
-/// as a batch of one would. Returns the threads it had, for
-/// cal_pool_alone_end, which gives them back.
-int cal_pool_alone_begin(int workers, int use_fork);
-void cal_pool_alone_end(int had);
-
 #endif
