@@ -17,6 +17,9 @@ void cal_cli_begin(int *argc, char ***argv, char *command, size_t len)
     for (int k = 0; k < *argc; ++k) snprintf(command + strlen(command), len - strlen(command), " %s", (*argv)[k]);
     cal_mpi_init(argc, argv);
 #ifdef _OPENMP
+    // The parent of forked workers stays on one thread for good: after a region on more threads,
+    // libgomp's thread pool makes a forked child hang (calib/runs/cal_case_runs.c, turned_bed_of).
+    // Threads go to the workers (calib/runs/cal_pool.c).
     omp_set_num_threads(1);
 #endif
 }

@@ -699,10 +699,11 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
     if (!t) {
         double fill_s;
         exp_drum_result res;
-        // On the parent's one thread (cal_pool.c): given the idle workers' cores as OpenMP threads, a
-        // λ 1000 bed turned at 241 s of wall a simulated second on this 2-core machine, where one thread
-        // a run took 91-179 (median ~110; the 12 λ 1000 4 rpm records of
-        // results/calibration-standard-kriging/, same k_n, two runs side by side).
+        // On the parent's one thread, though no worker runs now: a parent that has run an OpenMP
+        // region on more threads forks workers that can hang. libgomp keeps that team's threads in a
+        // pool, a child inherits the pool but not its threads, and its first smaller region waits for
+        // them to be released (the standard rerun's worker sat 20 min in a futex at 0 CPU, 2026-11-28,
+        // acc31a7, reverted). A bed wanting more threads is made in a forked worker (prepare_turned).
         dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
         if (!bed) return write_failed(env, run_key(b, r), err), NULL;
         // A file made by an earlier process was charged there; one made now by a worker, here.
