@@ -160,18 +160,20 @@ void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *correction, 
     *u = x[0], *v = x[1];
 }
 
+// The expensive runs' noise for measurement k (cal_mf_problem.run_noise; NULL: 0).
+static double tier_noise(const double *run_noise, int k) { return run_noise ? run_noise[k] : 0; }
+
 // The run's noise for measurement k: the problem's, or the run's own where larger.
 static double run_error(const cal_mf_problem *p, const cal_mf_point *run, int k)
 {
-    double noise = p->run_noise ? p->run_noise[k] : 0;
-    return fmax(noise, run->sd[k]);
+    return fmax(tier_noise(p->run_noise, k), run->sd[k]);
 }
 
 // A run with an error of its own above the problem's run noise (not steady).
 static int noisy(const cal_mf_problem *p, const cal_mf_point *run)
 {
     for (int k = 0; k < p->n_y; ++k)
-        if (run->sd[k] > (p->run_noise ? p->run_noise[k] : 0)) return 1;
+        if (run->sd[k] > tier_noise(p->run_noise, k)) return 1;
     return 0;
 }
 
@@ -221,7 +223,7 @@ static void krige_residuals(cal_mf_correction *c, double d[][CAL_MF_MAX_Y], cons
             double e = d[i][k] - plane_at(c, k, u[i], v[i]);
             gsl_vector_set(r, (size_t)i, e), ss += e * e;
         }
-        double noise = run_noise ? run_noise[k] : 0, scale = fmax(sqrt(ss / m), noise);
+        double noise = tier_noise(run_noise, k), scale = fmax(sqrt(ss / m), noise);
         for (int i = 0; i < m; ++i) {
             double e = err[i][k], ratio = scale > 0 ? e * e / (scale * scale) : 1;
             c->nugget[k][i] = fmax(ratio, 1e-9);

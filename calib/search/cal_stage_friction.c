@@ -113,12 +113,10 @@ int cal_candidate_run_vector(const cal_friction_result *r, const cal_candidate *
 
 int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, double *y)
 {
-    if (!isfinite(k->angle_deg)) return 1;
-    y[0] = k->angle_deg;
-    for (int i = 0; i < r->n_rpm; ++i) {
-        if (!k->usable[i] || !isfinite(k->csa[i])) return 1;
-        y[1 + i] = k->csa[i];
-    }
+    double sd[CAL_MAX_RPM + 1];
+    if (cal_candidate_run_vector(r, k, y, sd)) return 1;
+    for (int i = 0; i < r->n_rpm; ++i)
+        if (!k->usable[i]) return 1; // a speed not steady: not a point of any map
     return 0;
 }
 
