@@ -473,6 +473,7 @@ typedef struct plan_pass {
     int wall_grid_run[PLAN_MAX_TIERS]; ///< a wall stage of this tier ran its grid (expected figure)
     int wall_bed_kept[PLAN_MAX_TIERS]; ///< a one-bed wall stage of this tier settled its bed
     int turned_made[PLAN_MAX_TIERS][2]; ///< this tier's turned beds of stage 2 [0], stage 3 [1] made (expected figure)
+    const cal_plan_history *history;    ///< OUT/store's MSER runs: when such a run stops (expected figure)
 } plan_pass;
 
 typedef struct plan {
@@ -571,9 +572,17 @@ static void plan_batch(const run *r, plan_pass *pass, const cal_tier *t, const c
                        int speeds, int candidates, cal_plan_cost *cost)
 {
     if (candidates <= 0) return;
-    cal_drum_case d = cal_drum_case_granule(r->c, t, pass->k_n, r->c->granule_mu_s, r->c->granule_mu_r);
+    // A wall stage's case, so that its runs' kind (cal_drum_key_kind) is the wall stage's: the kind masks
+    // the pairs' values, but a wall pair other than the granules' (the centre of its search box) fills and
+    // turns the drum with two linings, as every wall stage's run does.
+    const double mu_s = r->c->granule_mu_s, mu_r = r->c->granule_mu_r;
+    double wall_mu_s, wall_mu_r;
+    cal_friction_to_mu(&r->c->wall, 0.5, 0.5, &wall_mu_s, &wall_mu_r);
+    cal_drum_case d = m ? cal_drum_case_wall(r->c, t, pass->k_n, mu_s, mu_r, wall_mu_s, wall_mu_r)
+                        : cal_drum_case_granule(r->c, t, pass->k_n, mu_s, mu_r);
     int beds = cal_tier_beds(t), *kept = &pass->wall_bed_kept[tier_slot(r, t)];
-    cal_plan_drum_batch(cost, &d, rpm, speeds, candidates, beds, m != NULL, m && *kept, pass->parallel, pass->worst);
+    cal_plan_drum_batch(cost, &d, rpm, speeds, candidates, beds, m != NULL, m && *kept, pass->parallel, pass->worst,
+                        pass->history);
     if (m && beds == 1) *kept = 1;
 }
 
@@ -634,10 +643,10 @@ static int plan_friction_steps(run *r, plan *p, plan_pass pass[2], const cal_mat
 }
 
 // Every step of the calibration (as plan_progress), its expected and worst cost.
-static int plan_cost(run *r, plan *p)
+static int plan_cost(run *r, plan *p, const cal_plan_history *history)
 {
     int parallel = r->env.workers * cal_mpi_size();
-    plan_pass pass[2] = {{.worst = 0, .k_n = p->k_expected, .parallel = parallel},
+    plan_pass pass[2] = {{.worst = 0, .k_n = p->k_expected, .parallel = parallel, .history = history},
                          {.worst = 1, .k_n = p->k_worst, .parallel = parallel}};
     if (wants(r, "stiffness")) {
         cal_plan *c = plan_step(p, "stiffness", cal_tier_stiffness_on_drum(r->t) ? "poured drum beds" : "poured cylinders");
@@ -670,11 +679,14 @@ static void print_plan(const run *r, const plan *p)
     fprintf(stderr, "== plan: expected %d simulations, %s; worst case %d simulations, %s; %.0f MB a simulation\n",
             p->total.expected.runs, e, p->total.worst.runs, w, fmax(p->total.expected.memory_mb, p->total.worst.memory_mb));
     fprintf(stderr, "   expected: each drum run ends at the steady test's first chance (two windows, then its averaging), "
-                    "a search's COBYLA starts at the grid's best (run already), the wall stages share one grid, a "
+                    "one under the MSER rule at the mean stop of the runs of its kind in %s/store where it holds at "
+                    "least %d (%d of the %d such runs here), else at max_time; a search's COBYLA starts at the grid's "
+                    "best (run already), the wall stages share one grid, a "
                     "two-tier stage runs all its max_evaluations and none of its posterior_runs; k_n %g N/m, %s. Worst "
                     "case: max_time every run, every candidate new (posterior_runs too), k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
                     "records already in %s/store are not subtracted.\n",
-            p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
+            r->out, CAL_PLAN_HISTORY_MIN, p->total.expected.mser_from_store, p->total.expected.mser_runs, p->k_expected,
+            p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
 }
 
 // The plan printed; refused if one simulation per worker cannot fit the
@@ -684,7 +696,12 @@ static int check_predicted_cost(run *r)
     plan *p = calloc(1, sizeof *p);
     if (!p) return exp_fail(r->err, sizeof r->err, "out of memory");
     plan_stiffness(r, p);
-    if (plan_cost(r, p)) return free(p), 1;
+    char store[1100];
+    snprintf(store, sizeof store, "%s/store", r->out);
+    cal_plan_history history;
+    int failed = cal_plan_history_read(&history, store, r->err, sizeof r->err) || plan_cost(r, p, &history);
+    cal_plan_history_free(&history);
+    if (failed) return free(p), 1;
     print_plan(r, p);
     int parallel = r->env.workers * cal_mpi_size();
     double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);

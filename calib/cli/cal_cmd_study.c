@@ -230,6 +230,10 @@ static double print_plan(const study *s)
     int parallel = s->opt.jobs * cal_mpi_size();
     double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
     cal_plan total = {{0}, {0}};
+    char store[1100], err[1024];
+    cal_plan_history history; // unreadable: the plan takes max_time for MSER runs, and says how many
+    snprintf(store, sizeof store, "%s/store", s->opt.out);
+    cal_plan_history_read(&history, store, err, sizeof err);
     fprintf(stderr, "== plan: study fidelity, %d seed(s) x %u speed(s) a rung, %d worker(s); expected (worst case)\n", f->seeds,
             f->rpm_count, parallel);
     for (unsigned k = 0; k < f->rungs_count; ++k) {
@@ -238,7 +242,8 @@ static double print_plan(const study *s)
         cal_plan p = {{0}, {0}};
         cal_drum_case d = cal_drum_case_granule(s->c, rung, s->c->k_n, s->c->granule_mu_s, s->c->granule_mu_r);
         for (int w = 0; w < 2; ++w)
-            cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w);
+            cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w,
+                                &history);
         int fits = spent + p.expected.wall_s <= budget_s;
         spent += fits ? p.expected.wall_s : 0;
         fprintf(stderr, "   %-22s %4d drum runs %8.2f (%8.2f) core-hours %7.2f (%7.2f) h%s\n", rung->name, p.expected.runs,
@@ -249,9 +254,11 @@ static double print_plan(const study *s)
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     fprintf(stderr, "== plan: the rungs within the budget (%.3g h): %d drum runs, expected %s; worst case %s\n"
-                    "   " CAL_PLAN_RUN_ASSUMPTION " At %.2g particle-steps per core-second (this project's 2-core machine); records "
-                    "already in the store are not subtracted.\n",
-            budget_s / 3600, total.expected.runs, e, w, CAL_PLAN_RATE);
+                    "   " CAL_PLAN_RUN_ASSUMPTION " (%d of %d MSER runs from %s.) At %.2g particle-steps per core-second (this "
+                    "project's 2-core machine); records already in the store are not subtracted.\n",
+            budget_s / 3600, total.expected.runs, e, w, total.expected.mser_from_store, total.expected.mser_runs, store,
+            CAL_PLAN_RATE);
+    cal_plan_history_free(&history);
     return total.expected.wall_s;
 }
 

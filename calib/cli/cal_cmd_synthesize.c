@@ -375,6 +375,10 @@ static void print_plan(const job *j)
     cal_plan total = {{0}, {0}};
     fprintf(stderr, "== plan: synthesize at tier '%s', %d worker(s); expected (worst case)\n", j->t->name, parallel);
     int wall_beds_made = 0; // the wall linings start from one set of turned beds (the frozen pair's)
+    char store[1100], err[1024];
+    cal_plan_history history; // unreadable: the plan takes max_time for MSER runs, and says how many
+    snprintf(store, sizeof store, "%s/store", j->out);
+    cal_plan_history_read(&history, store, err, sizeof err);
     for (int l = 0; l < j->n_linings; ++l) {
         cal_plan p = {{0}, {0}};
         cal_drum_case d = case_of(j, &j->linings[l], j->opt.seeds[0]);
@@ -383,7 +387,7 @@ static void print_plan(const job *j)
         for (int w = 0; w < 2; ++w) {
             cal_plan_cost *cost = w ? &p.worst : &p.expected;
             if (turned_beds_here) cal_plan_turned_beds(cost, &d, j->opt.n_seeds, parallel);
-            cal_plan_drum_batch(cost, &d, j->rpm, j->n_rpm, j->opt.n_seeds, 1, 0, 0, parallel, w);
+            cal_plan_drum_batch(cost, &d, j->rpm, j->n_rpm, j->opt.n_seeds, 1, 0, 0, parallel, w, &history);
         }
         fprintf(stderr, "   %-20s %4d drum runs %7.2f (%7.2f) core-hours %6.2f (%6.2f) h\n", j->linings[l].surface,
                 p.expected.runs, p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600,
@@ -393,9 +397,12 @@ static void print_plan(const job *j)
     char e[128], w[128];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     fprintf(stderr, "== plan: %d drum runs (%d lining(s) x %d seed(s) x %d speed(s)); expected %s; worst case %s; %.0f MB a "
-                    "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " k_n %g N/m. At %.2g particle-steps per core-second (this project's "
-                    "2-core machine); records already in the store or --reuse are not subtracted.\n",
-            total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb, j->k_n, CAL_PLAN_RATE);
+                    "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " (%d of %d MSER runs from %s.) k_n %g N/m. At %.2g particle-steps "
+                    "per core-second (this project's 2-core machine); records already in the store or --reuse are not "
+                    "subtracted.\n",
+            total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb,
+            total.expected.mser_from_store, total.expected.mser_runs, store, j->k_n, CAL_PLAN_RATE);
+    cal_plan_history_free(&history);
 }
 
 static int prepare(job *j)

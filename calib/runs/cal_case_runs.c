@@ -202,6 +202,23 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len)
     }
 }
 
+// Each value of `field` in text (up to the next space or ']') replaced by '*'.
+static void mask_values(char *text, const char *field)
+{
+    const size_t n = strlen(field);
+    for (char *at = strstr(text, field); at; at = strstr(at, field)) {
+        char *value = at + n, *end = value + strcspn(value, " ]");
+        if (end > value) *value = '*', memmove(value + 1, end, strlen(end) + 1);
+        at = value + 1;
+    }
+}
+
+void cal_drum_key_kind(const char *key, char *out, size_t len)
+{
+    snprintf(out, len, "%s", key);
+    mask_values(out, " mu="), mask_values(out, " seed=");
+}
+
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)
 {
     char gg[160], wall[160];

@@ -127,6 +127,10 @@ void cal_bed_key(const cal_bed_case *b, char *out, size_t len);
 /// The text that defines a simulation (hashed into its record's name).
 void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len);
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
+/// The kind of run a drum record's key names: the key with every friction
+/// pair and the seed masked ("mu=*", "seed=*"). Runs of one kind differ only
+/// by pairs and bed: the same drum, tier, speed and stopping rule.
+void cal_drum_key_kind(const char *key, char *out, size_t len);
 
 /// Records of the drum candidate at each speed, running the missing ones.
 /// 0 when every record is in hand (failed simulations included), else 1

@@ -5,14 +5,68 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst)
+#include "cal_store.h"
+
+// One stored run: kept if it is a usable drum run under the MSER rule.
+static void keep_mser_run(const cal_record *r, void *ctx)
+{
+    cal_plan_history *h = ctx;
+    if (!cal_record_usable(r) || strncmp(r->key, "drum ", 5) != 0 || !strstr(r->key, " steady=mser")) return;
+    if (h->n == h->cap) {
+        int cap = h->cap ? 2 * h->cap : 64;
+        char **kind = realloc(h->kind, (size_t)cap * sizeof *kind);
+        if (kind) h->kind = kind;
+        double *turn_s = kind ? realloc(h->turn_s, (size_t)cap * sizeof *turn_s) : NULL;
+        if (turn_s) h->turn_s = turn_s;
+        if (!kind || !turn_s) return; // out of memory: the plan knows one run fewer
+        h->cap = cap;
+    }
+    char text[4096];
+    cal_drum_key_kind(r->key, text, sizeof text);
+    if (!(h->kind[h->n] = strdup(text))) return;
+    h->turn_s[h->n++] = r->simulated_time_s;
+}
+
+int cal_plan_history_read(cal_plan_history *h, const char *store, char *err, size_t len)
+{
+    memset(h, 0, sizeof *h);
+    return cal_store_each(store, keep_mser_run, h, err, len) < 0;
+}
+
+void cal_plan_history_free(cal_plan_history *h)
+{
+    for (int i = 0; i < h->n; ++i) free(h->kind[i]);
+    free(h->kind), free(h->turn_s);
+    memset(h, 0, sizeof *h);
+}
+
+double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int *n)
+{
+    double sum = 0;
+    *n = 0;
+    for (int i = 0; h && i < h->n; ++i)
+        if (strcmp(h->kind[i], kind) == 0) sum += h->turn_s[i], ++*n;
+    return *n ? sum / *n : NAN;
+}
+
+double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst, const cal_plan_history *history,
+                          int *from_store)
 {
     exp_drum_run_opts o = cal_drum_run_opts(d, rpm);
-    // The MSER rule stops when the run's own series says so: nothing before
-    // the run predicts when, so both figures take its bound.
-    if (worst || o.steady_rule == EXP_STEADY_MSER) return o.max_time;
-    return fmin(o.max_time, 2 * o.window + o.average_time);
+    *from_store = 0;
+    if (worst) return o.max_time;
+    if (o.steady_rule != EXP_STEADY_MSER) return fmin(o.max_time, 2 * o.window + o.average_time);
+    // The MSER rule stops when the run's own series says so: only runs of
+    // the same kind tell when that tends to be.
+    char key[4096], kind[4096];
+    int n;
+    cal_drum_key(d, rpm, key, sizeof key), cal_drum_key_kind(key, kind, sizeof kind);
+    double mean = cal_plan_history_mean(history, kind, &n);
+    if (n < CAL_PLAN_HISTORY_MIN) return o.max_time;
+    *from_store = 1;
+    return fmin(o.max_time, mean);
 }
 
 double cal_plan_makespan(const double *task_s, int n, int parallel)
@@ -34,16 +88,21 @@ void cal_plan_turned_beds(cal_plan_cost *cost, const cal_drum_case *d, int beds,
 }
 
 void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const double *rpm, int n, int m, int beds,
-                         int wall_stage, int bed_kept, int parallel, int worst)
+                         int wall_stage, int bed_kept, int parallel, int worst, const cal_plan_history *history)
 {
     if (m <= 0 || n <= 0) return;
     exp_drum_cost unit = exp_drum_predict_cost(&d->def, 1.0); // turning steps per simulated second
     double fill_s = unit.fill_particle_steps / CAL_PLAN_RATE, turns_s = 0;
     double *turn_s = calloc((size_t)n, sizeof *turn_s);
     if (!turn_s) return;
-    for (int k = 0; k < n; ++k)
-        turn_s[k] = unit.turn_particle_steps * cal_plan_turn_time(d, rpm[k], worst) / CAL_PLAN_RATE, turns_s += turn_s[k];
     int tasks_per_bed = m * beds, shared_bed = tasks_per_bed == 1 || (wall_stage && beds == 1);
+    for (int k = 0; k < n; ++k) {
+        int from_store;
+        turn_s[k] = unit.turn_particle_steps * cal_plan_turn_time(d, rpm[k], worst, history, &from_store) / CAL_PLAN_RATE;
+        turns_s += turn_s[k];
+        if (cal_drum_run_opts(d, rpm[k]).steady_rule == EXP_STEADY_MSER)
+            cost->mser_runs += tasks_per_bed, cost->mser_from_store += from_store * tasks_per_bed;
+    }
     int n_tasks = shared_bed ? tasks_per_bed * n : tasks_per_bed;
     double *task = calloc((size_t)n_tasks, sizeof *task);
     if (!task) return free(turn_s);
@@ -64,6 +123,7 @@ void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t l
 static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
 {
     to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
+    to->mser_runs += c->mser_runs, to->mser_from_store += c->mser_from_store;
 }
 
 void cal_plan_add(cal_plan *total, const cal_plan *p)

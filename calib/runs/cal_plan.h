@@ -24,7 +24,32 @@ typedef struct cal_plan_cost {
     double core_s;      ///< their single-core seconds
     double wall_s;      ///< on the workers, batch after batch
     double memory_mb;   ///< the largest simulation's peak memory
+    int mser_runs;      ///< drum runs stopped by the MSER rule
+    int mser_from_store; ///< of those, how many a store's runs of their kind predict (cal_plan_history)
 } cal_plan_cost;
+
+/// What a store's runs say of when the MSER rule stops a run: each stored
+/// drum run under that rule (steady or not, failed ones left out), its kind
+/// (cal_drum_key_kind) and the simulated time it turned.
+typedef struct cal_plan_history {
+    int n, cap;
+    char **kind;
+    double *turn_s;
+} cal_plan_history;
+
+/// The fewest stored runs of a kind whose mean stop a plan takes for that
+/// kind: below it, the plan keeps max_time.
+#define CAL_PLAN_HISTORY_MIN 3
+
+/// Read the MSER runs of store folder `store` (none where it does not exist
+/// yet). 0, or 1 with a message.
+int cal_plan_history_read(cal_plan_history *h, const char *store, char *err, size_t len);
+void cal_plan_history_free(cal_plan_history *h);
+
+/// The mean simulated time of h's runs of `kind`, and their count in *n
+/// (the mean is the cost to expect: an MSER run either stops early or turns
+/// to max_time, so its stops have two modes).
+double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int *n);
 
 /// The figures of a plan: expected, and worst case.
 typedef struct cal_plan {
@@ -34,7 +59,8 @@ typedef struct cal_plan {
 /// What a drum run's expected and worst-case figures assume (cal_plan_turn_time), as a plan prints it.
 #define CAL_PLAN_RUN_ASSUMPTION \
     "expected: each run ends at the steady test's first chance (two windows, then its averaging; under the MSER " \
-    "rule max_time, as nothing predicts its stop); worst case: max_time."
+    "rule the mean stop of the store's runs of its kind where it holds at least 3, else max_time); worst case: " \
+    "max_time."
 
 /// Add plan p to a total, expected and worst case alike (runs, seconds; the
 /// largest memory).
@@ -42,11 +68,15 @@ void cal_plan_add(cal_plan *total, const cal_plan *p);
 
 /// Simulated seconds a drum run of case d turns at rpm: the worst case
 /// max_time; expected, the steady test's first chance (its two windows, then
-/// the averaging time), at most max_time; under the MSER rule max_time in
-/// both, since the run's own series decides its stop. Every λ 1000 run of the committed
+/// the averaging time), at most max_time. Every λ 1000 run of the committed
 /// standard calibration ended within 0.75 s of that (results/calibration-standard/
 /// simulations.csv: 10.05-10.75 s at 4 rpm, 4.0-4.1 s at 40 and 116).
-double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst);
+/// Under the MSER rule the run's own series decides its stop, which nothing
+/// but runs of its kind predicts: expected, the mean stop of history's runs
+/// of its kind where there are CAL_PLAN_HISTORY_MIN (*from_store = 1), else
+/// max_time (history may be NULL).
+double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst, const cal_plan_history *history,
+                          int *from_store);
 
 /// The turned beds of a stage whose tier starts some speeds turned
 /// (cal_drum_case.n_turned): one per bed (seed) and turned speed, each
@@ -61,8 +91,9 @@ void cal_plan_turned_beds(cal_plan_cost *cost, const cal_drum_case *d, int beds,
 /// `bed_kept` (a wall stage's bed settled earlier in the process), and each
 /// run is a task; otherwise each candidate's bed is a task that settles it
 /// and turns its speeds in turn. Added to *cost.
+/// `history` (may be NULL) as in cal_plan_turn_time.
 void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const double *rpm, int n, int m, int beds,
-                         int wall_stage, int bed_kept, int parallel, int worst);
+                         int wall_stage, int bed_kept, int parallel, int worst, const cal_plan_history *history);
 
 /// A batch of n independent tasks of task_s core-seconds each on `parallel`
 /// workers: the longest task or the total shared out, whichever is longer.

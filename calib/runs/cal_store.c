@@ -3,6 +3,7 @@
 #include "cal_store.h"
 
 #include <cyaml/cyaml.h>
+#include <dirent.h>
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
@@ -74,6 +75,23 @@ static int ends_with_newline(const char *path)
 
 enum { DAMAGED = -2 };
 
+// The record in file `path` (which exists) into *out: 0, or DAMAGED.
+static int load_file(const char *path, cal_record *out, char *err, size_t len)
+{
+    if (!ends_with_newline(path)) return exp_fail(err, len, "%s: cut short (no line break at its end)", path), DAMAGED;
+    cal_record *r = NULL;
+    if (exp_yaml_load(path, &record_schema, (void **)&r, "a damaged store record", err, len)) return DAMAGED;
+    *out = *r;
+    free(r); // the strings now belong to *out
+    return 0;
+}
+
+// A retry record another run wrote: its process was killed, so it counts as absent.
+static int retry_of_another_run(const cal_record *r)
+{
+    return r->retry && (!r->writer || strcmp(r->writer, this_run()) != 0);
+}
+
 // cal_store_get, with a damaged record (cut short, not YAML, a field
 // missing) told apart as DAMAGED from a record of another key (-1).
 static int load_record(const char *dir, const char *key, cal_record *out, char *err, size_t len)
@@ -82,16 +100,12 @@ static int load_record(const char *dir, const char *key, cal_record *out, char *
     cal_store_path(dir, key, path, sizeof path);
     memset(out, 0, sizeof *out);
     if (access(path, F_OK) != 0) return 1;
-    if (!ends_with_newline(path)) return exp_fail(err, len, "%s: cut short (no line break at its end)", path), DAMAGED;
-    cal_record *r = NULL;
-    if (exp_yaml_load(path, &record_schema, (void **)&r, "a damaged store record", err, len)) return DAMAGED;
-    if (strcmp(r->key, key) != 0) {
-        exp_yaml_free(&record_schema, r);
+    if (load_file(path, out, err, len)) return DAMAGED;
+    if (strcmp(out->key, key) != 0) {
+        cal_record_free(out);
         return exp_fail(err, len, "%s: holds a different simulation (hash collision); delete it", path), -1;
     }
-    *out = *r;
-    free(r); // the strings now belong to *out
-    if (out->retry && (!out->writer || strcmp(out->writer, this_run()) != 0)) {
+    if (retry_of_another_run(out)) {
         cal_record_free(out); // an earlier run's process was killed: run it again
         return 1;
     }
@@ -156,6 +170,32 @@ int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len)
             r->simulated_time_s, r->wall_time_s, r->dt_s, r->particle_steps, r->fill_wall_time_s, r->peak_rss_mb,
             isfinite(r->dt_margin_min) ? r->dt_margin_min : 0, r->dt_lowered, r->granules); // YAML 0, not nan: unchecked
     return exp_atomic_commit(&a, err, len);
+}
+
+// A record's file name: 16 hex digits and ".yaml" (not a partial write, a
+// turned bed, nor the damaged/ folder).
+static int record_file_name(const char *name)
+{
+    return strlen(name) == 21 && strspn(name, "0123456789abcdef") == 16 && strcmp(name + 16, ".yaml") == 0;
+}
+
+int cal_store_each(const char *dir, void (*visit)(const cal_record *r, void *ctx), void *ctx, char *err, size_t len)
+{
+    DIR *d = opendir(dir);
+    if (!d) return errno == ENOENT ? 0 : (exp_fail(err, len, "%s: cannot read the store: %s", dir, strerror(errno)), -1);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        char path[1300], why[1024];
+        cal_record r;
+        if (!record_file_name(e->d_name)) continue;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        memset(&r, 0, sizeof r);
+        if (load_file(path, &r, why, sizeof why)) continue; // damaged: the run that needs it deals with it
+        if (!retry_of_another_run(&r)) visit(&r, ctx), ++n;
+        cal_record_free(&r);
+    }
+    closedir(d);
+    return n;
 }
 
 void cal_record_free(cal_record *r)

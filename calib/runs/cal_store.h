@@ -52,6 +52,13 @@ int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, 
 /// counts as absent (1). A record of another key stays an error (-1).
 int cal_store_lookup(const char *dir, const char *key, cal_record *out, char *err, size_t len);
 
+/// Every record of the store, each handed to visit (the record is freed after
+/// the call), in no set order; damaged records and an earlier run's retry
+/// records are passed over, and the store is never changed. Returns the
+/// records visited (0 where the store does not exist yet), or -1 if the
+/// folder cannot be read (message).
+int cal_store_each(const char *dir, void (*visit)(const cal_record *r, void *ctx), void *ctx, char *err, size_t len);
+
 /// Write a record atomically. 0 on success.
 int cal_store_put(const char *dir, const cal_record *r, char *err, size_t len);
 
