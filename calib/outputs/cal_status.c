@@ -17,6 +17,16 @@ static void add_flag(cal_verdict *v, const char *flag)
     snprintf(v->flags + used, sizeof v->flags - used, "%s%s", used ? ";" : "", flag);
 }
 
+static void remove_flag(cal_verdict *v, const char *flag)
+{
+    char kept[sizeof v->flags] = "", *save = NULL;
+    for (char *f = strtok_r(v->flags, ";", &save); f; f = strtok_r(NULL, ";", &save))
+        if (strcmp(f, flag) != 0) snprintf(kept + strlen(kept), sizeof kept - strlen(kept), "%s%s", kept[0] ? ";" : "", f);
+    snprintf(v->flags, sizeof v->flags, "%s", kept);
+}
+
+static const char *open_flag(int side) { return side > 0 ? "not_excluded_to_upper_bound" : "not_excluded_to_lower_bound"; }
+
 // A value on a bound, relative to the bound's size (μr's bounds span decades).
 static int on_bound(double value, double bound) { return fabs(value - bound) <= 1e-9 * fabs(bound); }
 
@@ -38,12 +48,16 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
     }
     if (on_bound(value, bound_lo)) add_flag(&v, "at_lower_bound"), v.side = -1;
     if (on_bound(value, bound_hi)) add_flag(&v, "at_upper_bound"), v.side = +1;
+    v.on_bound = v.side != 0;
     int out_identified = outside(value, g.lo, g.hi);
     int out_bracket = isfinite(g.bracket_lo) && outside(value, g.bracket_lo, g.bracket_hi);
     if (out_identified) add_flag(&v, "outside_identified");
     if (out_bracket) add_flag(&v, "outside_not_excluded");
-    // Nothing excluded on either side: every value of the search range fits.
-    int none_excluded = isfinite(g.bracket_lo) && on_bound(g.bracket_lo, bound_lo) && on_bound(g.bracket_hi, bound_hi);
+    // The interval no run excludes, open to each bound it reaches; open to both, every value of the
+    // search range fits; open to one, with the value off the bounds, the data close one side only.
+    int open_lo = isfinite(g.bracket_lo) && on_bound(g.bracket_lo, bound_lo);
+    int open_hi = isfinite(g.bracket_hi) && on_bound(g.bracket_hi, bound_hi);
+    int none_excluded = open_lo && open_hi;
     if (none_excluded) add_flag(&v, "not_identified");
     if (angle_matched == 0) add_flag(&v, "angle_not_matched");
     // The strongest verdict wins: a value outside its own interval is no
@@ -51,8 +65,12 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
     // bound the data do not close gives one side only.
     if (out_identified || out_bracket) v.status = CAL_VALUE_NOT_A_RESULT, v.side = 0;
     else if (none_excluded) v.status = CAL_VALUE_NOT_IDENTIFIED, v.side = 0;
-    else if (v.side) {
-        // On the upper bound the data say only that μ is above the nearest
+    else if (!v.side && (open_lo || open_hi)) {
+        v.side = open_hi ? +1 : -1; // flagged only where it decides the status
+        add_flag(&v, open_flag(v.side));
+    }
+    if (v.status == CAL_VALUE_CALIBRATED && v.side) {
+        // Open upwards the data say only that μ is above the nearest
         // excluded value below (and the mirror on the lower bound).
         v.status = CAL_VALUE_ONE_SIDED;
         double other = v.side > 0 ? g.bracket_lo : g.bracket_hi;
@@ -63,7 +81,12 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
 
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
 {
-    if (!c || !c->known || v->status == CAL_VALUE_NOT_RUN || !outside(value, c->lo, c->hi)) return;
+    if (!c || !c->known || v->status == CAL_VALUE_NOT_RUN) return;
+    if (v->status == CAL_VALUE_ONE_SIDED && !v->on_bound && !(v->side > 0 ? c->reaches_upper : c->reaches_lower)) {
+        remove_flag(v, open_flag(v->side)); // the posterior closes the side the runs' cut leaves open
+        v->status = CAL_VALUE_CALIBRATED, v->side = 0, v->known = 0;
+    }
+    if (!outside(value, c->lo, c->hi)) return;
     // Beyond an end that runs to its search bound, the value lies between that end and the bound: the
     // posterior does not hold it off (its 2.5 % and 97.5 % points sit inside the bounds by construction).
     if ((value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower)) return;
@@ -204,8 +227,9 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
         if (st == CAL_VALUE_ONE_SIDED)
-            fprintf(f, ", only %s %.6g is known (the search stopped on its bound)", r->verdict.side > 0 ? ">=" : "<=",
-                    r->verdict.known);
+            fprintf(f, ", only %s %.6g is known (%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
+                    r->verdict.on_bound ? "the search stopped on its bound"
+                                        : "no run excludes a value from there to the search's bound");
         fprintf(f, " (%s)\n", r->verdict.flags);
     }
 }

@@ -22,7 +22,8 @@ typedef enum cal_value_status {
     CAL_VALUE_INPUT,          ///< given by the config (density, ξ)
     CAL_VALUE_DERIVED,        ///< set by a rule from another value (k_s = k_r = k_n; boundary = 2 k_n)
     CAL_VALUE_CALIBRATED,     ///< chosen by the data: inside its own interval, off the search's bounds
-    CAL_VALUE_ONE_SIDED,      ///< on a search bound the data do not close: only "≥ bound" or "≤ bound" is known
+    CAL_VALUE_ONE_SIDED,      ///< the data close one side only: the value on a search bound, or the interval no
+                              ///< run excludes running to one (with no posterior held off it): "≥ x" or "≤ x"
     CAL_VALUE_NOT_IDENTIFIED, ///< the data exclude no value of the search range
     CAL_VALUE_NOT_A_RESULT,   ///< the search's choice lies outside the interval its own data leave
     CAL_VALUE_NOT_RUN,        ///< its stage did not run: the config's value, or an unresolved stiffness sweep's
@@ -31,13 +32,15 @@ typedef enum cal_value_status {
 /// A value's status with the facts behind it.
 typedef struct cal_verdict {
     cal_value_status status;
-    int side;         ///< one-sided: +1 on the search's upper bound, -1 on its lower bound; else 0
+    int side;         ///< one-sided: +1 open towards the search's upper bound, -1 towards its lower; else 0
+    int on_bound;     ///< one-sided: 1 if the value itself is on that bound (0: off it, the interval reaching it)
     double known;     ///< one-sided: what the data do say, "≥ known" (side +1) or "≤ known" (side -1): the
                       ///< other end of the interval no candidate excludes (the value itself if none)
-    char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, outside_identified,
-                      ///< outside_not_excluded, outside_credible, not_identified, angle_not_matched,
-                      ///< stage_not_run, stiffness_at_cylinder_lambda (stage 1 swept a cylinder at another λ
-                      ///< than the drum's)
+    char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, not_excluded_to_lower_bound,
+                      ///< not_excluded_to_upper_bound (the value off the bound, the interval no run excludes
+                      ///< running to it), outside_identified, outside_not_excluded, outside_credible,
+                      ///< not_identified, angle_not_matched, stage_not_run, stiffness_at_cylinder_lambda (stage 1
+                      ///< swept a cylinder at another λ than the drum's)
 } cal_verdict;
 
 /// A friction's verdict from its identified range g (cal_range; NAN lo: the
@@ -49,7 +52,11 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
 /// Judge v against the friction's credible interval c: a value outside it is
 /// not a result (flag outside_credible), except beyond an end that runs to
 /// its search bound (a value on that bound: the posterior's 97.5 % point
-/// sits below the upper bound by construction).
+/// sits below the upper bound by construction). A value off the bounds that
+/// is one-sided only because the interval no run excludes reaches a bound is
+/// calibrated after all where the posterior is held off that bound: the
+/// posterior, which weighs every run and the map between them, closes the
+/// side the Δχ² cut over the runs leaves open.
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...

@@ -61,6 +61,16 @@ def expected_status(r, lo_bound, hi_bound):
         return 'not identified'
     if near(v, lo_bound) or near(v, hi_bound):
         return 'one-sided'
+    # Off the bounds, the interval no run excludes open to one of them: one side only is known, unless a
+    # posterior is held off that bound (it closes the side the runs' cut leaves open).
+    open_lo, open_hi = near(blo, lo_bound), near(bhi, hi_bound)
+    if open_lo or open_hi:
+        if r.get('credible_min', '') == '':
+            return 'one-sided'
+        reaches_lower, reaches_upper = reaches_bounds(r['parameter'], float(r['credible_min']),
+                                                      float(r['credible_max']), lo_bound, hi_bound)
+        if reaches_upper if open_hi else reaches_lower:
+            return 'one-sided'
     return 'calibrated'
 
 

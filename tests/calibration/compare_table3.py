@@ -6,9 +6,9 @@
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv > comparison.md
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv --expect COMMITTED.md
 #
-# A row whose status (calibrated_parameters.csv) says the data did not choose its value (one-sided on a
-# search bound, not identified, not a result, stage not run) is not scored as a pass or a fail of its
-# value: its verdict is that status.
+# A row whose status (calibrated_parameters.csv) says the data did not choose its value (one-sided: on
+# a search bound, or its interval open to one; not identified, not a result, stage not run) is not
+# scored as a pass or a fail of its value: its verdict is that status.
 # RUN_DIR holds calibrated_parameters.csv (value, not_excluded_min/max) and calibrated_parameters.md
 # (its Source column says whether stage 1 resolved the stiffness). Prints one row per tolerance
 # entry and a summary; exit status 0 when it could compare (whatever the verdicts), 2 on bad input.
@@ -43,7 +43,7 @@ def judge_status(rule, paper, got):
     if status in ('calibrated', 'input', 'derived') or rule == 'carried':
         return None
     if status == 'one-sided':
-        upper = 'at_upper_bound' in got['flags']
+        upper = 'at_upper_bound' in got['flags'] or 'not_excluded_to_upper_bound' in got['flags']
         known = float(got['not_excluded_min'] if upper else got['not_excluded_max'])
         holds = paper >= known if upper else paper <= known
         return 'one-sided', 'only %s %.3g known: Table 3 %s it' % ('≥' if upper else '≤', known,

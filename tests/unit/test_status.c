@@ -23,12 +23,51 @@ static cal_range range(double lo, double hi, double bracket_lo, double bracket_h
 static void test_inside_and_off_the_bounds_is_calibrated(void **state)
 {
     (void)state;
-    // The standard run's granule μr: 0.1918, identified at itself, not excluded 0.106 – 0.5 (bounds 1e-5, 0.5).
-    cal_verdict v = cal_verdict_friction(0.191835, range(0.191835, 0.191835, 0.105737, 0.5), 1e-5, 0.5, 1);
+    // The ci twin's PP μs: 0.775, identified at itself, not excluded 0.55 – 0.9 (bounds 0.1, 1).
+    cal_verdict v = cal_verdict_friction(0.775, range(0.775, 0.775, 0.55, 0.9), 0.1, 1.0, 1);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
     assert_string_equal(v.flags, "");
     char text[48];
+    assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.775, &v), "0.775");
+}
+
+static void test_an_interval_open_to_a_bound_is_one_sided(void **state)
+{
+    (void)state;
+    char text[48];
+    // The quick tier's granule μs: the search ended at 0.775, but no run excludes any value from 0.325 up
+    // to the bound 1: only μs ≥ 0.325 is known, whatever point the search stopped at.
+    cal_verdict v = cal_verdict_friction(0.775, range(0.775, 0.775, 0.325, 1.0), 0.1, 1.0, 1);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_int_equal(v.side, +1), assert_int_equal(v.on_bound, 0);
+    assert_float_equal(v.known, 0.325, 1e-12);
+    assert_string_equal(v.flags, "not_excluded_to_upper_bound");
+    assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.775, &v), "≥ 0.325");
+    // Its posterior runs to the same bound (0.585 - 0.993): still one-sided.
+    cal_credible to_upper = {1, 0.585, 0.993, 0, 1};
+    cal_verdict_credible(&v, 0.775, &to_upper);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    // A posterior held off that bound closes the side: calibrated, the open interval's flag gone.
+    // (The standard run's granule μr: 0.1918, not excluded 0.106 - 0.5, credible 0.098 - 0.33.)
+    v = cal_verdict_friction(0.191835, range(0.191835, 0.191835, 0.105737, 0.5), 1e-5, 0.5, 1);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    cal_credible held_off = {1, 0.0983423, 0.329743, 0, 0};
+    cal_verdict_credible(&v, 0.191835, &held_off);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    assert_int_equal(v.side, 0);
+    assert_string_equal(v.flags, "");
     assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.191835, &v), "0.1918");
+    // The mirror: the ci-lab run's PP μr 1.5e-4, not excluded from the bound 1e-5 up to 0.0334.
+    v = cal_verdict_friction(0.000149535, range(0.000149535, 0.000149535, 1e-5, 0.033437), 1e-5, 0.5, 1);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_int_equal(v.side, -1);
+    assert_string_equal(v.flags, "not_excluded_to_lower_bound");
+    assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.000149535, &v), "≤ 0.0334");
+    // Other flags stay where the open one goes (the angle not matched).
+    v = cal_verdict_friction(0.191835, range(0.191835, 0.191835, 0.105737, 0.5), 1e-5, 0.5, 0);
+    assert_string_equal(v.flags, "angle_not_matched;not_excluded_to_upper_bound");
+    cal_verdict_credible(&v, 0.191835, &held_off);
+    assert_string_equal(v.flags, "angle_not_matched");
 }
 
 static void test_a_bound_is_one_sided(void **state)
@@ -62,7 +101,7 @@ static void test_outside_its_own_interval_is_not_a_result(void **state)
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_int_equal(v.side, 0);
     // A value written at an end of its range to 6 digits stays inside it.
-    v = cal_verdict_friction(0.1918351, range(0.191835, 0.191835, 0.105737, 0.5), 1e-5, 0.5, 1);
+    v = cal_verdict_friction(0.1918351, range(0.191835, 0.191835, 0.105737, 0.3), 1e-5, 0.5, 1);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
 }
 
@@ -83,12 +122,13 @@ static void test_outside_its_credible_interval_is_not_a_result(void **state)
     // A value the Δχ² cut keeps (identified at itself, not excluded 1.5e-4 - 0.5) but the posterior puts
     // outside its 95 % credible interval 1.2e-5 - 0.02: not a result, whatever the runs' cut says.
     cal_verdict v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
-    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED); // by the runs' cut alone: open to the upper bound
     cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0};
     cal_verdict_credible(&v, 0.0334, &narrow);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_string_equal(v.flags, "outside_credible");
-    // Inside it, or with no posterior (a stage read from a stage file), nothing changes.
+    // Inside it (a posterior held off the upper bound: calibrated), then with no posterior (a stage read
+    // from a stage file), nothing changes.
     v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
     cal_credible wide = {1, 1.2e-5, 0.2, 1, 0}, none = {0};
     cal_verdict_credible(&v, 0.0334, &wide);
@@ -124,6 +164,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_inside_and_off_the_bounds_is_calibrated),
+        cmocka_unit_test(test_an_interval_open_to_a_bound_is_one_sided),
         cmocka_unit_test(test_a_bound_is_one_sided),
         cmocka_unit_test(test_outside_its_own_interval_is_not_a_result),
         cmocka_unit_test(test_nothing_excluded_is_not_identified),
