@@ -137,7 +137,7 @@ static const char *value_cell(char out[160], const cal_table_row *r)
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED && r->verdict.on_bound)
         snprintf(out, 160, "%s (the search stopped on its bound %.3g)", text, r->value);
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
-        snprintf(out, 160, "%s (the search ended at %.3g; no run excludes a value from %.3g to the bound)", text,
+        snprintf(out, 160, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound)", text,
                  r->value, r->verdict.known);
     else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
         snprintf(out, 160, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
