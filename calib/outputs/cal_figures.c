@@ -28,7 +28,7 @@ static exp_plot_series level(const double *y, const char *label, const double rg
 
 // ---- stage 1 ----------------------------------------------------------------------
 
-int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, char *err, size_t len)
+int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, const char *stamp, char *err, size_t len)
 {
     char path[1200], chosen_label[128];
     snprintf(path, sizeof path, "%s/cn_vs_k.png", dir);
@@ -51,7 +51,7 @@ int cal_figure_stiffness(const char *dir, const cal_stiffness_result *s, char *e
     series[4] = points(1, chosen_k, chosen_cn, chosen_label, red, s->resolved ? EXP_MARK_STAR : EXP_MARK_OPEN_CIRCLE);
     char title[96];
     snprintf(title, sizeof title, "Stage 1: coordination number of the %s (Fig. 12)", s->scene ? s->scene : "poured cylinder");
-    exp_plot_axes axes = {.title = title,
+    exp_plot_axes axes = {.title = title, .stamp = stamp,
                           .xlabel = "granule stiffness k_n (N/m, real powder)",
                           .ylabel = "coordination number (granule–granule)", .log_x = 1};
     return exp_plot_png(path, &axes, 5, series, WIDTH, HEIGHT, err, len);
@@ -91,7 +91,8 @@ static void map_legend(const cal_friction_result *r, int n, const char *note, ch
              r->n_levels > 1 ? " and predictions" : "", n, note);
 }
 
-static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_result *r, char *err, size_t len)
+static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_result *r, const char *stamp, char *err,
+                     size_t len)
 {
     double *mu_s = malloc(sizeof(double) * CAL_MAX_EVALS * 3);
     int *predicted = malloc(sizeof(int) * CAL_MAX_EVALS);
@@ -115,7 +116,7 @@ static int angle_map(const char *dir, const cal_bounds *b, const cal_friction_re
     if (r->best >= 0)
         snprintf(chosen, sizeof chosen, "the search's choice: μs = %.3g, μr = %.3g (its status: the table)",
                  r->cand[r->best].mu_s, r->cand[r->best].mu_r);
-    exp_plot_map m = {.title = title, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
+    exp_plot_map m = {.title = title, .stamp = stamp, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
                       .zlabel = mapped ? "angle (°), measured and predicted" : "angle (°)", .n = (size_t)r->n,
                       .x = mu_s, .y = mu_r, .z = angle,
                       .xlo = b->mu_s_min, .xhi = b->mu_s_max, .ylo = b->mu_r_min, .yhi = b->mu_r_max, .log_y = 1,
@@ -165,7 +166,7 @@ static void convergence_collect(const cal_friction_result *r, convergence_data *
     if (d->runs > 0) d->step_x[2 * d->runs - 1] = d->runs + 0.5;
 }
 
-static int convergence(const char *dir, const cal_friction_result *r, char *err, size_t len)
+static int convergence(const char *dir, const cal_friction_result *r, const char *stamp, char *err, size_t len)
 {
     convergence_data *d = malloc(sizeof *d);
     if (!d) return snprintf(err, len, "out of memory for the convergence plot"), 1;
@@ -187,7 +188,7 @@ static int convergence(const char *dir, const cal_friction_result *r, char *err,
         s[ns++] = points(1, d->chosen_index, d->chosen_objective, "the search's choice", red, EXP_MARK_STAR);
     if (d->map_points)
         s[ns++] = points((size_t)d->map_points, d->map_index, d->mapped, map_label, grey, EXP_MARK_OPEN_DIAMOND);
-    exp_plot_axes axes = {.title = title,
+    exp_plot_axes axes = {.title = title, .stamp = stamp,
                           .xlabel = d->map_points ? "run at this tier (0: the map tier's candidates, predicted)" : "evaluation",
                           .ylabel = r->angle_in_misfit ? "angle and CSA misfit (mean squared z)"
                                                        : "CSA misfit (mean squared z)",
@@ -234,7 +235,7 @@ double cal_figures_dodge(int k, double step)
     return (k % 2 ? -1 : 1) * ((k + 1) / 2) * step; // 0, -1, +1, -2, +2, ... steps
 }
 
-static int csa_vs_rpm(const char *dir, const cal_friction_result *r, char *err, size_t len)
+static int csa_vs_rpm(const char *dir, const cal_friction_result *r, const char *stamp, char *err, size_t len)
 {
     static char labels[MAX_SHOWN + 2][128];
     exp_plot_series s[MAX_SHOWN + 2];
@@ -274,17 +275,20 @@ static int csa_vs_rpm(const char *dir, const cal_friction_result *r, char *err, 
         snprintf(xlabel, sizeof xlabel, "drum speed (rpm); the series drawn up to ±%.2g rpm aside to keep their bars apart",
                  axis.widest_shift);
     else snprintf(xlabel, sizeof xlabel, "drum speed (rpm)");
-    exp_plot_axes axes = {.title = title, .xlabel = xlabel, .ylabel = "CSA (%)", .xlo = axis.lo, .xhi = axis.hi};
+    exp_plot_axes axes = {.title = title, .stamp = stamp, .xlabel = xlabel, .ylabel = "CSA (%)", .xlo = axis.lo,
+                          .xhi = axis.hi};
     return exp_plot_png(path, &axes, ns, s, WIDTH, HEIGHT, err, len);
 }
 
-int cal_figures_friction(const char *dir, const cal_bounds *bounds, const cal_friction_result *r, char *err, size_t len)
+int cal_figures_friction(const char *dir, const cal_bounds *bounds, const cal_friction_result *r, const char *stamp,
+                         char *err, size_t len)
 {
-    return angle_map(dir, bounds, r, err, len) || convergence(dir, r, err, len) || csa_vs_rpm(dir, r, err, len);
+    return angle_map(dir, bounds, r, stamp, err, len) || convergence(dir, r, stamp, err, len) ||
+           csa_vs_rpm(dir, r, stamp, err, len);
 }
 
 int cal_figure_posterior(const char *dir, const cal_bounds *bounds, const cal_friction_result *r,
-                         const cal_posterior *p, char *err, size_t len)
+                         const cal_posterior *p, const char *stamp, char *err, size_t len)
 {
     char path[1200], title[160], note[400];
     snprintf(path, sizeof path, "%s/posterior_%s.png", dir, stage_name(r));
@@ -294,7 +298,7 @@ int cal_figure_posterior(const char *dir, const cal_bounds *bounds, const cal_fr
              "solid: median\ndashed: 2.5, 97.5 %%\n★ the search's choice",
              p->median[0], p->lo[0], p->hi[0], p->median[1], p->lo[1], p->hi[1], p->n, CAL_POSTERIOR_CHAINS);
     const cal_candidate *best = r->best >= 0 ? &r->cand[r->best] : NULL;
-    exp_plot_corner c = {.title = title, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
+    exp_plot_corner c = {.title = title, .stamp = stamp, .xlabel = "sliding friction μs", .ylabel = "rolling friction μr",
                          .n = (size_t)p->n, .x = p->mu_s, .y = p->mu_r,
                          .xlo = bounds->mu_s_min, .xhi = bounds->mu_s_max, .ylo = bounds->mu_r_min, .yhi = bounds->mu_r_max,
                          .log_y = 1, .x_median = p->median[0], .x_lo = p->lo[0], .x_hi = p->hi[0],

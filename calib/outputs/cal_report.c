@@ -682,13 +682,17 @@ static int write_report(const char *dir, const cal_outcome *o, const posteriors 
 
 static int write_figures(const char *dir, const cal_outcome *o, const posteriors *post, char *err, size_t len)
 {
-    if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, err, len)) return 1;
+    char stamp[256];
+    cal_run_status rs = cal_run_status_of(o);
+    cal_run_stamp(stamp, sizeof stamp, &rs);
+    if (o->stiffness && isfinite(o->stiffness->chosen_k) && cal_figure_stiffness(dir, o->stiffness, stamp, err, len))
+        return 1;
     for (int i = 0; i < n_stages(o); ++i) {
         const cal_friction_result *r = stage_of(o, i);
         const cal_bounds *b = stage_bounds(o, i);
         if (!r) continue;
-        if (cal_figures_friction(dir, b, r, err, len)) return 1;
-        if (post->ok[i] && cal_figure_posterior(dir, b, r, &post->of[i], err, len)) return 1;
+        if (cal_figures_friction(dir, b, r, stamp, err, len)) return 1;
+        if (post->ok[i] && cal_figure_posterior(dir, b, r, &post->of[i], stamp, err, len)) return 1;
     }
     return 0;
 }

@@ -194,6 +194,13 @@ const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s)
     return out;
 }
 
+const char *cal_run_stamp(char *out, size_t len, const cal_run_status *s)
+{
+    snprintf(out, len, "%s, tier '%s', drum λ = %g; angle: %s, CSA: %s", s->demonstration ? "DEMONSTRATION" : "CALIBRATION",
+             s->tier, s->drum_lambda, s->angle_synthetic ? "SYNTHETIC" : "lab", s->csa_synthetic ? "SYNTHETIC" : "lab");
+    return out;
+}
+
 void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix)
 {
     if (s->demonstration)

@@ -99,6 +99,10 @@ const char *cal_run_purpose(const cal_run_status *s);
 /// The data's provenance in one field without commas or semicolons: "angle lab / CSA synthetic".
 const char *cal_run_data_text(char *out, size_t len, const cal_run_status *s);
 
+/// The banner's first three lines in one, for a figure: "CALIBRATION, tier
+/// 'standard', drum λ = 1000; angle: lab, CSA: SYNTHETIC".
+const char *cal_run_stamp(char *out, size_t len, const cal_run_status *s);
+
 /// The banner every output opens with, each line led by `prefix` ("# ",
 /// "> ", ""): what the run is, its λ, its data, and how to read each value's
 /// status.

@@ -216,7 +216,21 @@ static double ylabel_offset(void)
     return fmin(7.0, fmax(5.0, 0.7 + 0.85 * chars + 0.9));
 }
 
-static void title_and_labels(const char *title, const char *xlabel, const char *ylabel)
+// Room above the viewport: the title's, and a stamp's line above it.
+static double top_margin_chars(const char *stamp) { return stamp ? 5.0 : 3.2; }
+
+// What the figure is from, small and at the left above the title (the
+// current viewport's top): a figure copied alone still says it.
+static void stamp_line(const char *stamp)
+{
+    if (!stamp) return;
+    plcol0(INK);
+    text_size(SMALL);
+    plmtex("t", 3.4, 0.0, 0.0, stamp);
+    text_size(TEXT);
+}
+
+static void title_and_labels(const char *title, const char *stamp, const char *xlabel, const char *ylabel)
 {
     plcol0(INK);
     if (xlabel) plmtex("b", 3.2, 0.5, 0.5, xlabel);
@@ -226,6 +240,7 @@ static void title_and_labels(const char *title, const char *xlabel, const char *
         plmtex("t", 1.2, 0.5, 0.5, title);
         text_size(TEXT);
     }
+    stamp_line(stamp);
 }
 
 // Grey grid lines at the major ticks, under what is drawn next.
@@ -710,9 +725,9 @@ static void legend_draw(const legend *l, page p)
 
 // The viewport in mm: room on the left for the y labels, below for the x
 // label and the legend, above for the title, and on the right for `right_mm`.
-static void viewport(page p, double right_mm, const legend *l)
+static void viewport(page p, double right_mm, const legend *l, const char *stamp)
 {
-    double left = 8.0 * p.char_mm, top = 3.2 * p.char_mm;
+    double left = 8.0 * p.char_mm, top = top_margin_chars(stamp) * p.char_mm;
     double bottom = 4.4 * p.char_mm + (l->n ? legend_height_mm(l, p) + 0.8 * p.char_mm : 0);
     plsvpa(left, p.width - right_mm, bottom, p.height - top);
 }
@@ -728,7 +743,7 @@ int exp_plot_png(const char *path, const exp_plot_axes *a, size_t ns, const exp_
     legend l;
     legend_of_series(&l, ns, s, NULL);
     page p = page_size();
-    viewport(p, 2.5 * p.char_mm, &l);
+    viewport(p, 2.5 * p.char_mm, &l, a->stamp);
     // Which series' bars hide behind their markers needs the viewport's height,
     // which needs the legend's: its entries are redone with the note, the viewport after.
     int *hidden = calloc(ns ? ns : 1, sizeof *hidden), any_hidden = 0;
@@ -737,7 +752,7 @@ int exp_plot_png(const char *path, const exp_plot_axes *a, size_t ns, const exp_
         any_hidden |= hidden[k] = s[k].label && bars_within_marker(&s[k], log_x, log_y, &area, p.char_mm);
     if (any_hidden) {
         legend_of_series(&l, ns, s, hidden);
-        viewport(p, 2.5 * p.char_mm, &l);
+        viewport(p, 2.5 * p.char_mm, &l, a->stamp);
         area = current_area(p, xr, yr);
     }
     free(hidden);
@@ -749,7 +764,7 @@ int exp_plot_png(const char *path, const exp_plot_axes *a, size_t ns, const exp_
     }
     draw_names(ns, s, log_x, log_y, &area, p);
     frame(log_x, log_y, xr.lo, xr.hi, yr.lo, yr.hi); // over what was drawn at its edges
-    title_and_labels(a->title, a->xlabel, a->ylabel);
+    title_and_labels(a->title, a->stamp, a->xlabel, a->ylabel);
     legend_draw(&l, p);
     return end_figure(&f, err, len);
 }
@@ -1103,7 +1118,7 @@ int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int hei
     plscol0(BAND, 0, 0, 0), plscol0(CHOSEN, 215, 25, 28), plscol0(PREDICTED, 90, 90, 90);
     legend l = map_legend(m, g->filled, BAND, CHOSEN, PREDICTED);
     page p = page_size();
-    viewport(p, (g->filled ? 10 : 2.5) * p.char_mm, &l);
+    viewport(p, (g->filled ? 10 : 2.5) * p.char_mm, &l, m->stamp);
     double pad_x, pad_y;
     pad_window(g, p, &pad_x, &pad_y);
     plwind(g->x0 - pad_x, g->x1 + pad_x, g->y0 - pad_y, g->y1 + pad_y);
@@ -1122,7 +1137,7 @@ int exp_plot_map_png(const char *path, const exp_plot_map *m, int width, int hei
     map_markers(m, CHOSEN, PREDICTED);
     if (!g->filled) map_values(m, g);
     if (g->filled) colour_bar(m, levels);
-    title_and_labels(m->title, m->xlabel, m->ylabel);
+    title_and_labels(m->title, m->stamp, m->xlabel, m->ylabel);
     legend_draw(&l, p);
     free(g);
     return end_figure(&f, err, len);
@@ -1233,7 +1248,8 @@ int exp_plot_corner_png(const char *path, const exp_plot_corner *c, int width, i
     set_colour(FIRST_SERIES_COLOUR, rgb);
     plscol0(CHOSEN, 215, 25, 28);
     page p = page_size();
-    double left = 8.0 * p.char_mm, bottom = 4.4 * p.char_mm, top = 3.2 * p.char_mm, right = 2.5 * p.char_mm;
+    double left = 8.0 * p.char_mm, bottom = 4.4 * p.char_mm, top = top_margin_chars(c->stamp) * p.char_mm;
+    double right = 2.5 * p.char_mm;
     double gap = 1.0 * p.char_mm;
     double a_w = (p.width - left - right - gap) * 0.7, a_h = (p.height - bottom - top - gap) * 0.7;
     double b_w = p.width - left - right - gap - a_w, b_h = p.height - bottom - top - gap - a_h;
@@ -1249,6 +1265,7 @@ int exp_plot_corner_png(const char *path, const exp_plot_corner *c, int width, i
     plsvpa(left, left + a_w, bottom + a_h + gap, bottom + a_h + gap + b_h); // x histogram above
     corner_histogram(c, 0, x0, x1);
     if (c->title) text_size(TITLE), plmtex("t", 1.2, 0.0, 0.0, c->title), text_size(TEXT);
+    stamp_line(c->stamp);
     plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom, bottom + a_h); // y histogram to the right
     corner_histogram(c, 1, y0, y1);
     plsvpa(left + a_w + gap, left + a_w + gap + b_w, bottom + a_h + gap, bottom + a_h + gap + b_h);

@@ -56,6 +56,7 @@ typedef struct exp_plot_series {
 /// error bars), padded; a range of one value is widened to ±10 % of it.
 typedef struct exp_plot_axes {
     const char *title, *xlabel, *ylabel;
+    const char *stamp; ///< what the figure is from (a run's tier, λ, data), small above the title; NULL: none
     double xlo, xhi, ylo, yhi;
     int log_y; ///< logarithmic y axis (non-positive values are skipped)
     int log_x; ///< logarithmic x axis (non-positive values are skipped)
@@ -77,6 +78,7 @@ int exp_plot_png(const char *path, const exp_plot_axes *axes, size_t n_series, c
 /// tolerance) drawn only where the map is filled; one point starred.
 typedef struct exp_plot_map {
     const char *title, *xlabel, *ylabel, *zlabel; ///< zlabel: the colour bar's
+    const char *stamp;                            ///< as exp_plot_axes.stamp
     size_t n;
     const double *x, *y, *z; ///< a non-finite z: a failed evaluation, marked by a cross
     double xlo, xhi, ylo, yhi; ///< the rectangle (the search's bounds)
@@ -131,6 +133,7 @@ double exp_plot_settled_from(size_t n, const double *t, const double *y, double 
 /// support (the search's bounds).
 typedef struct exp_plot_corner {
     const char *title, *xlabel, *ylabel;
+    const char *stamp;         ///< as exp_plot_axes.stamp
     size_t n;
     const double *x, *y;       ///< the samples
     double xlo, xhi, ylo, yhi; ///< the axes: the support

@@ -62,6 +62,21 @@ static int distinct_colours(const unsigned char *px, size_t pixels, int enough)
     return n;
 }
 
+// The RGB pixels of PNG `path` (free them), its size in *width, *height.
+static unsigned char *read_rgb(const char *path, unsigned *width, unsigned *height)
+{
+    png_image img;
+    memset(&img, 0, sizeof img);
+    img.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&img, path)) fail_msg("%s is not a PNG: %s", path, img.message);
+    img.format = PNG_FORMAT_RGB;
+    unsigned char *px = malloc(3 * (size_t)img.width * img.height);
+    assert_non_null(px);
+    assert_true(png_image_finish_read(&img, NULL, px, 0, NULL));
+    *width = img.width, *height = img.height;
+    return px;
+}
+
 // The file is a PNG of more than min_bytes with at least min_colours colours.
 static void assert_figure(const char *name, long min_bytes, int min_colours)
 {
@@ -70,15 +85,9 @@ static void assert_figure(const char *name, long min_bytes, int min_colours)
     struct stat st;
     if (stat(path, &st) != 0) fail_msg("%s was not written", path);
     if (st.st_size < min_bytes) fail_msg("%s: %ld bytes, expected more than %ld", path, (long)st.st_size, min_bytes);
-    png_image img;
-    memset(&img, 0, sizeof img);
-    img.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&img, path)) fail_msg("%s is not a PNG: %s", path, img.message);
-    img.format = PNG_FORMAT_RGB;
-    size_t pixels = (size_t)img.width * img.height;
-    unsigned char *px = malloc(3 * pixels);
-    assert_non_null(px);
-    assert_true(png_image_finish_read(&img, NULL, px, 0, NULL));
+    unsigned width, height;
+    unsigned char *px = read_rgb(path, &width, &height);
+    size_t pixels = (size_t)width * height;
     int colours = distinct_colours(px, pixels, min_colours);
     free(px);
     if (colours < min_colours) fail_msg("%s: %d colours, expected at least %d", path, colours, min_colours);
@@ -135,6 +144,36 @@ static void chart_on_log_axes(void **state)
     assert_figure("chart_log.png", 5000, 3);
 }
 
+// Dark pixels in the band across the top 6 % of the page, left of its middle.
+static long ink_top_left(const char *path)
+{
+    unsigned width, height;
+    unsigned char *px = read_rgb(path, &width, &height);
+    long dark = 0;
+    for (unsigned y = 0; y < height * 6 / 100; ++y)
+        for (unsigned x = 0; x < width * 4 / 10; ++x) {
+            const unsigned char *c = px + 3 * ((size_t)y * width + x);
+            dark += c[0] < 128 && c[1] < 128 && c[2] < 128;
+        }
+    free(px);
+    return dark;
+}
+
+// A stamp (what the figure is from) is drawn above the title, at the left; none without one.
+static void stamp_above_the_title(void **state)
+{
+    double x[3] = {1, 2, 3}, y[3] = {2, 3, 2.5};
+    exp_plot_series s = {.n = 3, .x = x, .y = y, .label = "data", .style = EXP_PLOT_LINE_POINTS};
+    exp_plot_axes a = {.title = "T", .xlabel = "x", .ylabel = "y"};
+    char plain[1200], stamped[1200], err[512];
+    path_in_dir(plain, sizeof plain, "chart_unstamped.png"), path_in_dir(stamped, sizeof stamped, "chart_stamped.png");
+    if (exp_plot_png(plain, &a, 1, &s, 1000, 640, err, sizeof err)) fail_msg("%s", err);
+    a.stamp = "DEMONSTRATION, tier 'quick', drum λ = 65536; angle: lab, CSA: SYNTHETIC";
+    if (exp_plot_png(stamped, &a, 1, &s, 1000, 640, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(ink_top_left(plain), 0);
+    assert_true(ink_top_left(stamped) > 100);
+}
+
 // ---- the calibration's figures ----------------------------------------------------------
 
 static void stiffness_sweep(void **state)
@@ -143,7 +182,9 @@ static void stiffness_sweep(void **state)
                               .cn_sd = {0.08, 0.07, 0.05, 0.06, 0.05}, .stiff_limit = 4.45, .tolerance = 0.12,
                               .chosen_k = 800, .resolved = 1};
     char err[512];
-    if (cal_figure_stiffness(dir, &s, err, sizeof err)) fail_msg("%s", err);
+    if (cal_figure_stiffness(dir, &s, "CALIBRATION, tier 'check', drum λ = 32768; angle: lab, CSA: SYNTHETIC",
+                             err, sizeof err))
+        fail_msg("%s", err);
     assert_figure("cn_vs_k.png", 8000, 6);
 }
 
@@ -183,13 +224,13 @@ static void friction_figures(void **state)
     cal_bounds b = {0.1, 1.0, 0.001, 1.0};
     char err[512];
     friction_stage(r, 1);
-    if (cal_figures_friction(dir, &b, r, err, sizeof err)) fail_msg("%s", err);
+    if (cal_figures_friction(dir, &b, r, NULL, err, sizeof err)) fail_msg("%s", err);
     assert_figure("angle_map_PTFE.png", 20000, 20);
     assert_figure("convergence_PTFE.png", 8000, 6);
     assert_figure("csa_vs_rpm_PTFE.png", 8000, 6);
     friction_stage(r, 4);
     snprintf(r->material, sizeof r->material, "aluminium");
-    if (cal_figures_friction(dir, &b, r, err, sizeof err)) fail_msg("%s", err);
+    if (cal_figures_friction(dir, &b, r, NULL, err, sizeof err)) fail_msg("%s", err);
     assert_figure("csa_vs_rpm_aluminium.png", 8000, 6);
     free(r);
 }
@@ -210,7 +251,7 @@ static void two_tier_figures_with_the_target_not_reached(void **state)
     r->csa_source = (cal_provenance){1, 512};
     for (int i = 5; i < r->n; ++i) r->cand[i].predicted = 1;
     r->cand[0].mu_s = 1.0, r->cand[0].mu_r = 0.5, r->best = 0; // the chosen on the bounds' corner
-    if (cal_figures_friction(dir, &b, r, err, sizeof err)) fail_msg("%s", err);
+    if (cal_figures_friction(dir, &b, r, NULL, err, sizeof err)) fail_msg("%s", err);
     assert_figure("angle_map_PP.png", 20000, 20);
     assert_figure("convergence_PP.png", 8000, 6);
     assert_figure("csa_vs_rpm_PP.png", 8000, 6);
@@ -377,6 +418,7 @@ int main(void)
         cmocka_unit_test(chart_with_every_style),
         cmocka_unit_test(chart_of_one_x_value),
         cmocka_unit_test(chart_on_log_axes),
+        cmocka_unit_test(stamp_above_the_title),
         cmocka_unit_test(stiffness_sweep),
         cmocka_unit_test(friction_figures),
         cmocka_unit_test(two_tier_figures_with_the_target_not_reached),
