@@ -213,10 +213,11 @@ static void mask_values(char *text, const char *field)
     }
 }
 
-void cal_drum_key_kind(const char *key, char *out, size_t len)
+void cal_drum_key_kind(const char *key, int any_scale, char *out, size_t len)
 {
     snprintf(out, len, "%s", key);
     mask_values(out, " mu="), mask_values(out, " seed=");
+    if (any_scale) mask_values(out, " lambda="), mask_values(out, " depth="), mask_values(out, "[k=");
 }
 
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len)

@@ -129,8 +129,11 @@ void cal_drum_key(const cal_drum_case *c, double rpm, char *out, size_t len);
 void cal_cylinder_key(const exp_cylinder_def *c, char *out, size_t len);
 /// The kind of run a drum record's key names: the key with every friction
 /// pair and the seed masked ("mu=*", "seed=*"). Runs of one kind differ only
-/// by pairs and bed: the same drum, tier, speed and stopping rule.
-void cal_drum_key_kind(const char *key, char *out, size_t len);
+/// by pairs and bed: the same drum, tier, speed and stopping rule. With
+/// any_scale, the coarse-graining λ, the slice depth and the stiffnesses
+/// are masked too ("lambda=*", "depth=*", "k=*"): the same drum, speed, start
+/// and stopping rule at any λ and k_n.
+void cal_drum_key_kind(const char *key, int any_scale, char *out, size_t len);
 
 /// Records of the drum candidate at each speed, running the missing ones.
 /// 0 when every record is in hand (failed simulations included), else 1

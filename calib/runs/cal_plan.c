@@ -18,14 +18,20 @@ static void keep_mser_run(const cal_record *r, void *ctx)
         int cap = h->cap ? 2 * h->cap : 64;
         char **kind = realloc(h->kind, (size_t)cap * sizeof *kind);
         if (kind) h->kind = kind;
-        double *turn_s = kind ? realloc(h->turn_s, (size_t)cap * sizeof *turn_s) : NULL;
+        char **any_scale = kind ? realloc(h->any_scale, (size_t)cap * sizeof *any_scale) : NULL;
+        if (any_scale) h->any_scale = any_scale;
+        double *turn_s = any_scale ? realloc(h->turn_s, (size_t)cap * sizeof *turn_s) : NULL;
         if (turn_s) h->turn_s = turn_s;
-        if (!kind || !turn_s) return; // out of memory: the plan knows one run fewer
+        if (!turn_s) return; // out of memory: the plan knows one run fewer
         h->cap = cap;
     }
-    char text[4096];
-    cal_drum_key_kind(r->key, text, sizeof text);
-    if (!(h->kind[h->n] = strdup(text))) return;
+    char text[4096], scale_free[4096];
+    cal_drum_key_kind(r->key, 0, text, sizeof text), cal_drum_key_kind(r->key, 1, scale_free, sizeof scale_free);
+    h->kind[h->n] = strdup(text), h->any_scale[h->n] = strdup(scale_free);
+    if (!h->kind[h->n] || !h->any_scale[h->n]) {
+        free(h->kind[h->n]), free(h->any_scale[h->n]);
+        return;
+    }
     h->turn_s[h->n++] = r->simulated_time_s;
 }
 
@@ -37,17 +43,17 @@ int cal_plan_history_read(cal_plan_history *h, const char *store, char *err, siz
 
 void cal_plan_history_free(cal_plan_history *h)
 {
-    for (int i = 0; i < h->n; ++i) free(h->kind[i]);
-    free(h->kind), free(h->turn_s);
+    for (int i = 0; i < h->n; ++i) free(h->kind[i]), free(h->any_scale[i]);
+    free(h->kind), free(h->any_scale), free(h->turn_s);
     memset(h, 0, sizeof *h);
 }
 
-double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int *n)
+double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int any_scale, int *n)
 {
     double sum = 0;
     *n = 0;
     for (int i = 0; h && i < h->n; ++i)
-        if (strcmp(h->kind[i], kind) == 0) sum += h->turn_s[i], ++*n;
+        if (strcmp(any_scale ? h->any_scale[i] : h->kind[i], kind) == 0) sum += h->turn_s[i], ++*n;
     return *n ? sum / *n : NAN;
 }
 
@@ -61,12 +67,14 @@ double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst, const c
     // The MSER rule stops when the run's own series says so: only runs of
     // the same kind tell when that tends to be.
     char key[4096], kind[4096];
-    int n;
-    cal_drum_key(d, rpm, key, sizeof key), cal_drum_key_kind(key, kind, sizeof kind);
-    double mean = cal_plan_history_mean(history, kind, &n);
-    if (n < CAL_PLAN_HISTORY_MIN) return o.max_time;
-    *from_store = 1;
-    return fmin(o.max_time, mean);
+    cal_drum_key(d, rpm, key, sizeof key);
+    for (int any_scale = 0; any_scale < 2; ++any_scale) {
+        int n;
+        cal_drum_key_kind(key, any_scale, kind, sizeof kind);
+        double mean = cal_plan_history_mean(history, kind, any_scale, &n);
+        if (n >= CAL_PLAN_HISTORY_MIN) return *from_store = 1 + any_scale, fmin(o.max_time, mean);
+    }
+    return o.max_time;
 }
 
 double cal_plan_makespan(const double *task_s, int n, int parallel)
@@ -100,8 +108,11 @@ void cal_plan_drum_batch(cal_plan_cost *cost, const cal_drum_case *d, const doub
         int from_store;
         turn_s[k] = unit.turn_particle_steps * cal_plan_turn_time(d, rpm[k], worst, history, &from_store) / CAL_PLAN_RATE;
         turns_s += turn_s[k];
-        if (cal_drum_run_opts(d, rpm[k]).steady_rule == EXP_STEADY_MSER)
-            cost->mser_runs += tasks_per_bed, cost->mser_from_store += from_store * tasks_per_bed;
+        if (cal_drum_run_opts(d, rpm[k]).steady_rule == EXP_STEADY_MSER) {
+            cost->mser_runs += tasks_per_bed;
+            if (from_store == 1) cost->mser_from_store += tasks_per_bed;
+            if (from_store == 2) cost->mser_from_other_scale += tasks_per_bed;
+        }
     }
     int n_tasks = shared_bed ? tasks_per_bed * n : tasks_per_bed;
     double *task = calloc((size_t)n_tasks, sizeof *task);
@@ -124,6 +135,7 @@ static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
 {
     to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);
     to->mser_runs += c->mser_runs, to->mser_from_store += c->mser_from_store;
+    to->mser_from_other_scale += c->mser_from_other_scale;
 }
 
 void cal_plan_add(cal_plan *total, const cal_plan *p)

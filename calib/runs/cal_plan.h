@@ -25,15 +25,17 @@ typedef struct cal_plan_cost {
     double wall_s;      ///< on the workers, batch after batch
     double memory_mb;   ///< the largest simulation's peak memory
     int mser_runs;      ///< drum runs stopped by the MSER rule
-    int mser_from_store; ///< of those, how many a store's runs of their kind predict (cal_plan_history)
+    int mser_from_store; ///< of those, how many a store's runs of their own kind predict (cal_plan_history)
+    int mser_from_other_scale; ///< how many runs of their kind at another λ or k_n predict
 } cal_plan_cost;
 
 /// What a store's runs say of when the MSER rule stops a run: each stored
 /// drum run under that rule (steady or not, failed ones left out), its kind
-/// (cal_drum_key_kind) and the simulated time it turned.
+/// and its kind at any scale (cal_drum_key_kind) and the simulated time it
+/// turned.
 typedef struct cal_plan_history {
     int n, cap;
-    char **kind;
+    char **kind, **any_scale;
     double *turn_s;
 } cal_plan_history;
 
@@ -46,10 +48,10 @@ typedef struct cal_plan_history {
 int cal_plan_history_read(cal_plan_history *h, const char *store, char *err, size_t len);
 void cal_plan_history_free(cal_plan_history *h);
 
-/// The mean simulated time of h's runs of `kind`, and their count in *n
-/// (the mean is the cost to expect: an MSER run either stops early or turns
-/// to max_time, so its stops have two modes).
-double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int *n);
+/// The mean simulated time of h's runs of `kind` (any_scale: of that kind at
+/// any scale), and their count in *n (the mean is the cost to expect: an MSER
+/// run either stops early or turns to max_time, so its stops have two modes).
+double cal_plan_history_mean(const cal_plan_history *h, const char *kind, int any_scale, int *n);
 
 /// The figures of a plan: expected, and worst case.
 typedef struct cal_plan {
@@ -59,7 +61,8 @@ typedef struct cal_plan {
 /// What a drum run's expected and worst-case figures assume (cal_plan_turn_time), as a plan prints it.
 #define CAL_PLAN_RUN_ASSUMPTION \
     "expected: each run ends at the steady test's first chance (two windows, then its averaging; under the MSER " \
-    "rule the mean stop of the store's runs of its kind where it holds at least 3, else max_time); worst case: " \
+    "rule the mean stop of the store's runs of its kind where it holds at least 3, of its kind at another λ or " \
+    "k_n where those are 3, else max_time); worst case: " \
     "max_time."
 
 /// Add plan p to a total, expected and worst case alike (runs, seconds; the
@@ -73,8 +76,10 @@ void cal_plan_add(cal_plan *total, const cal_plan *p);
 /// simulations.csv: 10.05-10.75 s at 4 rpm, 4.0-4.1 s at 40 and 116).
 /// Under the MSER rule the run's own series decides its stop, which nothing
 /// but runs of its kind predicts: expected, the mean stop of history's runs
-/// of its kind where there are CAL_PLAN_HISTORY_MIN (*from_store = 1), else
-/// max_time (history may be NULL).
+/// of its kind where there are CAL_PLAN_HISTORY_MIN (*from_store = 1); else
+/// of its kind at another λ or k_n (*from_store = 2: a finer λ's series is
+/// smoother, so it should reach its standard error no later); else max_time
+/// (*from_store = 0; history may be NULL).
 double cal_plan_turn_time(const cal_drum_case *d, double rpm, int worst, const cal_plan_history *history,
                           int *from_store);
 

@@ -25,11 +25,17 @@ static void test_kind_masks_pairs_and_seed(void **state)
     (void)state;
     char kind[512];
     // As cal_drum_key writes them: each pair in a contact's text, the bed's seed, a turned start's pairs.
-    cal_drum_key_kind("drum D=0.1 granule[k=200 xi=0.7 mu=1,0.14 damping=0] wall[k=400 xi=0.7 mu=0.3,0.01 damping=0] "
-                      "seed=12 rpm=4 start=turned[time=10 granule[k=200 xi=0.7 mu=0.5,0.1 damping=0]]",
-                      kind, sizeof kind);
-    assert_string_equal(kind, "drum D=0.1 granule[k=200 xi=0.7 mu=* damping=0] wall[k=400 xi=0.7 mu=* damping=0] "
-                              "seed=* rpm=4 start=turned[time=10 granule[k=200 xi=0.7 mu=* damping=0]]");
+    const char *key = "drum D=0.1 depth=0.009 lambda=1000 granule[k=200,200,200 xi=0.7 mu=1,0.14 damping=0] "
+                      "wall[k=400,400,400 xi=0.7 mu=0.3,0.01 damping=0] seed=12 rpm=4 "
+                      "start=turned[time=10 granule[k=200,200,200 xi=0.7 mu=0.5,0.1 damping=0]]";
+    cal_drum_key_kind(key, 0, kind, sizeof kind);
+    assert_string_equal(kind, "drum D=0.1 depth=0.009 lambda=1000 granule[k=200,200,200 xi=0.7 mu=* damping=0] "
+                              "wall[k=400,400,400 xi=0.7 mu=* damping=0] seed=* rpm=4 "
+                              "start=turned[time=10 granule[k=200,200,200 xi=0.7 mu=* damping=0]]");
+    // At any scale: λ, the slice depth and the stiffnesses too.
+    cal_drum_key_kind(key, 1, kind, sizeof kind);
+    assert_string_equal(kind, "drum D=0.1 depth=* lambda=* granule[k=* xi=0.7 mu=* damping=0] wall[k=* xi=0.7 mu=* "
+                              "damping=0] seed=* rpm=4 start=turned[time=10 granule[k=* xi=0.7 mu=* damping=0]]");
 }
 
 // The standard tier's granule case: its 4 rpm runs start turned, under the MSER rule.
@@ -44,15 +50,21 @@ static cal_config *standard(const cal_tier **t)
 }
 
 // A record of the granule case (mu_s, mu_r) on bed `seed` at rpm that turned `simulated` s.
-static void put_run(const char *store, const cal_config *c, const cal_tier *t, double mu_s, double mu_r, int seed,
-                    double rpm, double simulated, const char *status)
+static void put_run_k(const char *store, const cal_config *c, const cal_tier *t, double k_n, double mu_s, double mu_r,
+                      int seed, double rpm, double simulated, const char *status)
 {
     char key[4096], err[1024];
-    cal_drum_case d = cal_drum_case_granule(c, t, 200, mu_s, mu_r);
+    cal_drum_case d = cal_drum_case_granule(c, t, k_n, mu_s, mu_r);
     cal_drum_case_set_seed(&d, (uint64_t)seed);
     cal_drum_key(&d, rpm, key, sizeof key);
     cal_record r = {.key = key, .status = (char *)status, .reason = "", .simulated_time_s = simulated, .granules = 1};
     if (cal_store_put(store, &r, err, sizeof err)) fail_msg("%s", err);
+}
+
+static void put_run(const char *store, const cal_config *c, const cal_tier *t, double mu_s, double mu_r, int seed,
+                    double rpm, double simulated, const char *status)
+{
+    put_run_k(store, c, t, 200, mu_s, mu_r, seed, rpm, simulated, status);
 }
 
 static void test_mser_stop_from_the_runs_of_its_kind(void **state)
@@ -99,6 +111,17 @@ static void test_mser_stop_from_the_runs_of_its_kind(void **state)
     cal_plan_drum_batch(&cost, &d, rpm, 2, 3, 1, 0, 0, 2, 0, &h);
     assert_int_equal(cost.runs, 6);
     assert_int_equal(cost.mser_runs, 3), assert_int_equal(cost.mser_from_store, 3);
+    assert_int_equal(cost.mser_from_other_scale, 0);
+    // The same drum at another k_n has no run of its own kind: those of its kind at any scale predict it.
+    cal_drum_case soft = cal_drum_case_granule(c, t, 50, 0.8, 0.2);
+    assert_float_equal(cal_plan_turn_time(&soft, 4, 0, &h, &from_store), (3.0 + max_time + 6.0) / 3, 1e-12);
+    assert_int_equal(from_store, 2);
+    cal_plan_history_free(&h);
+    // Its own kind, where the store holds 3, comes first (stops of 1 s at k_n 50).
+    for (int seed = 1; seed <= 3; ++seed) put_run_k(store, c, t, 50, 0.5, 0.1, seed, 4, 1.0, "ok");
+    assert_int_equal(cal_plan_history_read(&h, store, err, sizeof err), 0);
+    assert_float_equal(cal_plan_turn_time(&soft, 4, 0, &h, &from_store), 1.0, 1e-12);
+    assert_int_equal(from_store, 1);
     cal_plan_history_free(&h);
     // No store yet: no history, no error.
     assert_int_equal(cal_plan_history_read(&h, "/tmp/granucal_plan_no_such_store", err, sizeof err), 0);
