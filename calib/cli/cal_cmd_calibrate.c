@@ -707,6 +707,7 @@ static int check_predicted_cost(run *r)
     cal_plan_history_free(&history);
     if (failed) return free(p), 1;
     print_plan(r, p);
+    for (int k = 0; k < p->n; ++k) cal_progress_expect(&r->progress, p->name[k], p->step[k].expected.runs);
     int parallel = r->env.workers * cal_mpi_size();
     double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);
     char e[128], w[128];

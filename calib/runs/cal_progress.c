@@ -35,8 +35,20 @@ int cal_progress_plan(cal_progress *p, const char *name, cal_run_kind kind, int 
     if (p->n_stages == CAL_PROGRESS_MAX_STAGES) return 1;
     cal_progress_stage *s = &p->stage[p->n_stages++];
     snprintf(s->name, sizeof s->name, "%s", name);
-    s->kind = kind, s->planned = planned > 0 ? planned : 0, s->done = 0;
+    s->kind = kind, s->planned = s->expected = planned > 0 ? planned : 0, s->done = 0;
     return 0;
+}
+
+int cal_progress_expect(cal_progress *p, const char *name, int expected)
+{
+    if (!p) return 0;
+    for (int k = 0; k < p->n_stages; ++k)
+        if (strcmp(p->stage[k].name, name) == 0) {
+            cal_progress_stage *s = &p->stage[k];
+            s->expected = expected < 0 ? 0 : expected > s->planned ? s->planned : expected;
+            return 0;
+        }
+    return 1;
 }
 
 int cal_progress_enter(cal_progress *p, const char *name)
@@ -61,12 +73,20 @@ static int left_in(const cal_progress *p, int k)
     return left > 0 ? left : 0;
 }
 
-double cal_progress_eta_s(const cal_progress *p)
+// Simulations stage k runs still if it runs its expected count.
+static int expected_left_in(const cal_progress *p, int k)
+{
+    int left = p->stage[k].expected - p->stage[k].done;
+    return left > 0 ? left : 0;
+}
+
+// The stages' `left` simulations at their kinds' measured costs, shared by those run at once.
+static double time_left(const cal_progress *p, int (*left_of)(const cal_progress *, int))
 {
     if (!p || p->n_stages == 0) return NAN;
     double seconds = 0;
     for (int k = p->current < 0 ? 0 : p->current; k < p->n_stages; ++k) {
-        int left = left_in(p, k);
+        int left = left_of(p, k);
         cal_run_kind kind = p->stage[k].kind;
         if (left == 0) continue;
         if (p->cost_n[kind] == 0) return NAN;
@@ -74,6 +94,10 @@ double cal_progress_eta_s(const cal_progress *p)
     }
     return seconds / p->parallel;
 }
+
+double cal_progress_eta_s(const cal_progress *p) { return time_left(p, left_in); }
+
+double cal_progress_expected_eta_s(const cal_progress *p) { return time_left(p, expected_left_in); }
 
 // The first kind still to run without a cost, for "time left after the first ... run".
 static const char *uncosted_kind(const cal_progress *p)
@@ -98,12 +122,14 @@ void cal_progress_describe(const cal_progress *p, char *out, size_t len)
     for (int k = 0; k < p->n_stages; ++k) done += p->stage[k].done, planned += p->stage[k].planned;
     if (planned < done) planned = done;
     int at = p->current < 0 ? 0 : p->current;
-    char left[64];
-    double eta = cal_progress_eta_s(p);
+    char left[96];
+    double eta = cal_progress_eta_s(p), expected = cal_progress_expected_eta_s(p);
     if (isfinite(eta)) {
-        char d[32];
-        format_duration(eta, d, sizeof d);
-        snprintf(left, sizeof left, "≤ %s left", d);
+        char d[32], e[32];
+        format_duration(eta, d, sizeof d), format_duration(expected, e, sizeof e);
+        // The expected time beside the bound only where they differ as printed.
+        if (isfinite(expected) && strcmp(d, e) != 0) snprintf(left, sizeof left, "~%s left expected, ≤ %s", e, d);
+        else snprintf(left, sizeof left, "≤ %s left", d);
     } else snprintf(left, sizeof left, "time left after the first %s run", uncosted_kind(p));
     snprintf(out, len, "step %d of %d (%s), %d of ≤ %d simulations, %s", at + 1, p->n_stages, p->stage[at].name, done,
              planned, left);

@@ -40,8 +40,9 @@ enum { CAL_PROGRESS_MAX_STAGES = 1 + 17 * (CAL_MAX_MAP_DEPTH + 1) };
 typedef struct cal_progress_stage {
     char name[64]; ///< a material's name (< 32), with its level (cal_progress_level_name)
     cal_run_kind kind;
-    int planned; ///< at most this many simulations
-    int done;    ///< run now or found in the store
+    int planned;  ///< at most this many simulations
+    int expected; ///< as many as a typical run takes (the plan's expected figure; `planned` until told)
+    int done;     ///< run now or found in the store
 } cal_progress_stage;
 
 typedef struct cal_progress {
@@ -60,6 +61,11 @@ void cal_progress_init(cal_progress *p, int parallel);
 /// if the plan is full.
 int cal_progress_plan(cal_progress *p, const char *name, cal_run_kind kind, int planned);
 
+/// The stage called `name` is expected to run `expected` simulations (the
+/// plan's expected figure, at most its `planned`); 0, or 1 if it was not
+/// planned.
+int cal_progress_expect(cal_progress *p, const char *name, int expected);
+
 /// The stage called `name` is running now (later counts go to it); 0, or 1
 /// if it was not planned. Every function takes p == NULL and does nothing.
 int cal_progress_enter(cal_progress *p, const char *name);
@@ -70,6 +76,10 @@ void cal_progress_count(cal_progress *p, cal_run_kind kind, double wall_s);
 
 /// Wall seconds left at most, NAN while a kind still to run has no cost.
 double cal_progress_eta_s(const cal_progress *p);
+
+/// Wall seconds left if each stage runs its expected count (a stage past it
+/// has none left), NAN while a kind still to run has no cost.
+double cal_progress_expected_eta_s(const cal_progress *p);
 
 /// "step 2 of 5 (granule), 14 of ≤ 86 simulations, ≤ 1.2 h left" (or
 /// "time left after the first drum run"); empty when p is NULL or unplanned.

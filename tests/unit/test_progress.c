@@ -90,6 +90,30 @@ static void test_a_stage_ended_early_leaves_nothing(void **state)
     assert_float_equal(cal_progress_eta_s(&p), 0, 0);
 }
 
+// The plan's expected counts beside the bound: granule and PTFE expected to run 6 of their 10.
+static void test_expected_time_beside_the_bound(void **state)
+{
+    (void)state;
+    cal_progress p;
+    char text[200];
+    plan_three(&p);
+    assert_int_equal(cal_progress_expect(&p, "granule", 6), 0);
+    assert_int_equal(cal_progress_expect(&p, "PTFE", 6), 0);
+    assert_int_equal(cal_progress_expect(&p, "aluminium", 6), 1); // not planned
+    assert_int_equal(cal_progress_expect(&p, "stiffness", 40), 0); // never above the plan's bound
+    cal_progress_enter(&p, "granule");
+    for (int k = 0; k < 2; ++k) cal_progress_count(&p, CAL_RUN_DRUM, 600);
+    // Left: at most 8 + 10, expected 4 + 6, at 600 s, two at once.
+    assert_float_equal(cal_progress_eta_s(&p), 18 * 600.0 / 2, 1e-9);
+    assert_float_equal(cal_progress_expected_eta_s(&p), 10 * 600.0 / 2, 1e-9);
+    cal_progress_describe(&p, text, sizeof text);
+    assert_string_equal(text, "step 2 of 3 (granule), 2 of ≤ 24 simulations, ~50 min left expected, ≤ 1.5 h");
+    // A stage past its expected count has no expected runs left, only its bound's.
+    for (int k = 0; k < 5; ++k) cal_progress_count(&p, CAL_RUN_DRUM, 600);
+    assert_float_equal(cal_progress_expected_eta_s(&p), 6 * 600.0 / 2, 1e-9);
+    assert_float_equal(cal_progress_eta_s(&p), 13 * 600.0 / 2, 1e-9);
+}
+
 static void test_unplanned_and_null(void **state)
 {
     (void)state;
@@ -112,6 +136,7 @@ int main(void)
                                        cmocka_unit_test(test_time_left_from_measured_costs),
         cmocka_unit_test(test_map_tier_runs_have_their_own_cost),
                                        cmocka_unit_test(test_a_stage_ended_early_leaves_nothing),
+                                       cmocka_unit_test(test_expected_time_beside_the_bound),
                                        cmocka_unit_test(test_unplanned_and_null)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
