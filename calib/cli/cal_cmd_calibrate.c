@@ -165,7 +165,9 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
     snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
     exp_atomic_file a;
     if (exp_atomic_open(&a, path, err, len)) return 1;
-    fprintf(a.f, "# written by granucal calibrate; read by later stages run alone\nk_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
+    fprintf(a.f, "# written by granucal calibrate; read by later stages run alone. Not the table: the pair a later stage "
+                 "freezes,\n# whatever its status (a bound, not a result); what each value is: calibrated_parameters.*\n"
+                 "k_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
             k_n, mu_s, mu_r);
     if (ranges && isfinite(ranges[1].lo))
         fprintf(a.f, "mu_s_identified_min: %.17g\nmu_s_identified_max: %.17g\nmu_r_identified_min: %.17g\n"
