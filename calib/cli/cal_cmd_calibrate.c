@@ -72,15 +72,16 @@ static const char epilogue[] =
     "batch over the ranks (OUT must be on a filesystem all ranks share).\n"
     "\n"
     "Outputs in OUT: calibrated_parameters.{csv,md,h5} (value, identified_min/max,\n"
-    "not_excluded_min/max, status and flags: calibrated, one-sided at a search bound,\n"
-    "not identified, not a result; the run's tier, lambda, data and purpose on every\n"
-    "row; the posterior's median and 95 % credible interval), simulations.csv,\n"
-    "report.md (every candidate, its chi^2, the ranges, the posterior, which\n"
-    "measurement moves with which friction), cn_vs_k.png, angle_map_*.png,\n"
-    "csa_vs_rpm_*.png, convergence_*.png, posterior_*.png, liggghts_parameters.in,\n"
-    "lammps_parameters.in, and complete decks of the drum: liggghts_drum.in,\n"
-    "lammps_drum.in. A tier marked `purpose: demonstration` (quick, ci, check) makes\n"
-    "a demonstration, never a calibration, and every output says so.\n";
+    "not_excluded_min/max, status and flags: calibrated, one-sided (on a search bound,\n"
+    "or its interval open to one), not identified, not a result; the run's tier,\n"
+    "lambda, data and purpose on every row; the posterior's median and 95 % credible\n"
+    "interval), simulations.csv, report.md (every candidate, its chi^2, the ranges,\n"
+    "the posterior, which measurement moves with which friction), cn_vs_k.png,\n"
+    "angle_map_*.png, csa_vs_rpm_*.png, convergence_*.png, posterior_*.png,\n"
+    "liggghts_parameters.in, lammps_parameters.in, and complete decks of the drum:\n"
+    "liggghts_drum.in, lammps_drum.in. A tier marked `purpose: demonstration` (quick,\n"
+    "ci, check) makes a demonstration, never a calibration, and every output says\n"
+    "so, each figure above its title.\n";
 
 typedef struct options {
     const char *config, *tier, *stage, *material, *out, *data;
