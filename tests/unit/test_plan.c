@@ -90,6 +90,22 @@ static void test_mser_stop_from_the_runs_of_its_kind(void **state)
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fputs("key: 'drum", f), fclose(f);
+    // So is a retry record another run's killed process left (absent to every run): were it read, it
+    // would be the third run of the kind and set the mean.
+    {
+        char key[4096];
+        cal_drum_case other = cal_drum_case_granule(c, t, 200, 0.9, 0.3);
+        cal_drum_case_set_seed(&other, 7);
+        cal_drum_key(&other, 4, key, sizeof key);
+        cal_store_path(store, key, path, sizeof path);
+        f = fopen(path, "w");
+        assert_non_null(f);
+        fprintf(f, "key: '%s'\nstatus: 'ok'\nreason: ''\nwriter: 'elsewhere:1'\nretry: true\n"
+                   "simulated_time_s: 0.5\ngranules: 1\n", key);
+        fclose(f);
+        cal_record r;
+        assert_int_equal(cal_store_get(store, key, &r, err, sizeof err), 1); // absent to a run, too
+    }
     assert_int_equal(cal_plan_history_read(&h, store, err, sizeof err), 0);
     assert_float_equal(cal_plan_turn_time(&d, 4, 0, &h, &from_store), max_time, 0);
     assert_int_equal(from_store, 0);
