@@ -683,17 +683,17 @@ static void print_plan(const run *r, const plan *p)
     cal_plan_describe(&p->total.expected, parallel, e, sizeof e), cal_plan_describe(&p->total.worst, parallel, w, sizeof w);
     fprintf(stderr, "== plan: expected %d simulations, %s; worst case %d simulations, %s; %.0f MB a simulation\n",
             p->total.expected.runs, e, p->total.worst.runs, w, fmax(p->total.expected.memory_mb, p->total.worst.memory_mb));
+    char store[1100], mser[1300];
+    snprintf(store, sizeof store, "%s/store", r->out);
+    cal_plan_describe_mser(&p->total.expected, store, mser, sizeof mser);
     fprintf(stderr, "   expected: each drum run ends at the steady test's first chance (two windows, then its averaging), "
-                    "one under the MSER rule at the mean stop of the runs of its kind in %s/store where it holds at "
-                    "least %d (%d of the %d such runs here; %d more from runs of their kind at another λ or k_n), else "
-                    "at max_time; a search's COBYLA starts at the grid's "
-                    "best (run already), the wall stages share one grid, a "
+                    "one under the MSER rule at the mean stop of the stored runs of its kind where there are at least "
+                    "%d (%s), else at max_time; a search's COBYLA starts at the grid's best (run already), the wall "
+                    "stages share one grid, a "
                     "two-tier stage runs all its max_evaluations and none of its posterior_runs; k_n %g N/m, %s. Worst "
                     "case: max_time every run, every candidate new (posterior_runs too), k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
                     "records already in %s/store are not subtracted.\n",
-            r->out, CAL_PLAN_HISTORY_MIN, p->total.expected.mser_from_store, p->total.expected.mser_runs,
-            p->total.expected.mser_from_other_scale, p->k_expected,
-            p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
+            CAL_PLAN_HISTORY_MIN, mser, p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
 }
 
 // The plan printed; refused if one simulation per worker cannot fit the

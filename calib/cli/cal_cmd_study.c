@@ -251,14 +251,13 @@ static double print_plan(const study *s)
                 fits ? "" : "  over the budget left: not run");
         if (fits) cal_plan_add(&total, &p);
     }
-    char e[128], w[128];
+    char e[128], w[128], mser[1300];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
+    cal_plan_describe_mser(&total.expected, store, mser, sizeof mser);
     fprintf(stderr, "== plan: the rungs within the budget (%.3g h): %d drum runs, expected %s; worst case %s\n"
-                    "   " CAL_PLAN_RUN_ASSUMPTION " (%d of %d MSER runs from %s, %d more from runs of their kind at "
-                    "another λ or k_n.) At %.2g particle-steps per core-second (this project's 2-core machine); records "
-                    "already in the store are not subtracted.\n",
-            budget_s / 3600, total.expected.runs, e, w, total.expected.mser_from_store, total.expected.mser_runs, store,
-            total.expected.mser_from_other_scale, CAL_PLAN_RATE);
+                    "   " CAL_PLAN_RUN_ASSUMPTION " (%s.) At %.2g particle-steps per core-second (this project's 2-core "
+                    "machine); records already in the store are not subtracted.\n",
+            budget_s / 3600, total.expected.runs, e, w, mser, CAL_PLAN_RATE);
     cal_plan_history_free(&history);
     return total.expected.wall_s;
 }

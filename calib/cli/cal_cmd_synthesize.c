@@ -394,14 +394,13 @@ static void print_plan(const job *j)
                 p.worst.wall_s / 3600);
         cal_plan_add(&total, &p);
     }
-    char e[128], w[128];
+    char e[128], w[128], mser[1300];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
+    cal_plan_describe_mser(&total.expected, store, mser, sizeof mser);
     fprintf(stderr, "== plan: %d drum runs (%d lining(s) x %d seed(s) x %d speed(s)); expected %s; worst case %s; %.0f MB a "
-                    "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " (%d of %d MSER runs from %s, %d more from runs of their "
-                    "kind at another λ or k_n.) k_n %g N/m. At %.2g particle-steps per core-second (this project's "
-                    "2-core machine); records already in the store or --reuse are not subtracted.\n",
-            total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb,
-            total.expected.mser_from_store, total.expected.mser_runs, store, total.expected.mser_from_other_scale, j->k_n,
+                    "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " (%s.) k_n %g N/m. At %.2g particle-steps per core-second "
+                    "(this project's 2-core machine); records already in the store or --reuse are not subtracted.\n",
+            total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb, mser, j->k_n,
             CAL_PLAN_RATE);
     cal_plan_history_free(&history);
 }

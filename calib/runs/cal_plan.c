@@ -131,6 +131,12 @@ void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t l
     snprintf(out, len, "%.2g core-hours, %.2g h on %d worker(s)", c->core_s / 3600, c->wall_s / 3600, parallel);
 }
 
+void cal_plan_describe_mser(const cal_plan_cost *c, const char *store, char *out, size_t len)
+{
+    snprintf(out, len, "%d of %d MSER runs from %s, %d more from runs of their kind at another λ or k_n",
+             c->mser_from_store, c->mser_runs, store, c->mser_from_other_scale);
+}
+
 static void add_cost(cal_plan_cost *to, const cal_plan_cost *c)
 {
     to->runs += c->runs, to->core_s += c->core_s, to->wall_s += c->wall_s, to->memory_mb = fmax(to->memory_mb, c->memory_mb);

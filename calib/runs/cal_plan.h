@@ -108,4 +108,9 @@ double cal_plan_makespan(const double *task_s, int n, int parallel);
 /// significant figures.
 void cal_plan_describe(const cal_plan_cost *c, int parallel, char *out, size_t len);
 
+/// How c's MSER runs were predicted (cal_plan_turn_time), as every plan
+/// prints it: "4 of 16 MSER runs from OUT/store, 4 more from runs of their
+/// kind at another λ or k_n".
+void cal_plan_describe_mser(const cal_plan_cost *c, const char *store, char *out, size_t len);
+
 #endif
