@@ -45,7 +45,8 @@ static const char synopsis[] =
     "run agrees with the corrected map within the data's noise (max_evaluations runs).\n"
     "With posterior_runs: N, up to N more runs follow, each where the posterior is\n"
     "still held wide by the corrected map's own uncertainty; none where its width is\n"
-    "the data's (docs/calibration.md).\n"
+    "the data's (docs/calibration.md); with return_runs: M, up to M more after them\n"
+    "at the corrected optimum they moved.\n"
     "Where NAME has a map_tier of its own, NAME's stage is itself two-tier (levels:\n"
     "ci -> lambda 1000 -> lambda 512, the fine-levels tier): its runs and its corrected\n"
     "map's predictions are the map of the level above, which corrects them only by the\n"
@@ -382,7 +383,7 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
                                                "stage 2, best misfit (angle outside its tolerance)",
                                                "stage 2, closest (angle not matched)"};
         *source = friction_source(r->granule, sources);
-        r->table.gg_angle_matched = r->granule->cand[r->granule->best].angle_violation <= 0;
+        r->table.gg_angle_matched = cal_candidate_angle_matched(&r->granule->cand[r->granule->best]);
         const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
         return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
     }
@@ -416,7 +417,7 @@ static int stage_walls(run *r, double k_n, double gg_mu_s, double gg_mu_r)
                                                "stage 3, best misfit (angle outside its tolerance)",
                                                "stage 3, closest (angle not matched)"};
         snprintf(r->table.wall_source[t], 96, "%s", friction_source(w, sources));
-        r->table.wall_angle_matched[t] = w->cand[w->best].angle_violation <= 0;
+        r->table.wall_angle_matched[t] = cal_candidate_angle_matched(&w->cand[w->best]);
     }
     return 0;
 }
@@ -458,8 +459,8 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 //    bed (the granule pair frozen), run for the first material, found in the
 //    store by the others;
 //  - a two-tier stage runs all its max_evaluations at its own tier, and none of
-//    its posterior_runs (those only where the posterior asks; the worst case
-//    counts them): it stops
+//    its posterior_runs or return_runs (those only where the posterior asks;
+//    the worst case counts them): it stops
 //    earlier only when a run agrees with the corrected map within the data's
 //    noise, or the map's optimum returns to a point already run, and with
 //    the standard tier's small noise that is the exception (the committed
@@ -606,7 +607,8 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
         *turned_made = 1;
     }
     if (deciding) {
-        int runs = t->max_evaluations + (pass->worst ? t->posterior_runs : 0); // the posterior's only where it asks
+        // the posterior's, and the return's after them, only where the posterior asks
+        int runs = t->max_evaluations + (pass->worst ? t->posterior_runs + t->return_runs : 0);
         for (int i = 0; i < runs; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
         return 0;
     }
@@ -690,8 +692,8 @@ static void print_plan(const run *r, const plan *p)
                     "one under the MSER rule at the mean stop of the stored runs of its kind where there are at least "
                     "%d (%s), else at max_time; a search's COBYLA starts at the grid's best (run already), the wall "
                     "stages share one grid, a "
-                    "two-tier stage runs all its max_evaluations and none of its posterior_runs; k_n %g N/m, %s. Worst "
-                    "case: max_time every run, every candidate new (posterior_runs too), k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
+                    "two-tier stage runs all its max_evaluations and none of its posterior_runs or return_runs; k_n %g N/m, %s. Worst "
+                    "case: max_time every run, every candidate new (posterior_runs and return_runs too), k_n %g N/m. At %.2g particle-steps per core-second (this project's 2-core machine); "
                     "records already in %s/store are not subtracted.\n",
             CAL_PLAN_HISTORY_MIN, mser, p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
 }

@@ -72,6 +72,7 @@ static const cyaml_schema_field_t tier_fields[] = {
                          CYAML_ARRAY_LEN(corrections)),
     CYAML_FIELD_INT("beds", CYAML_FLAG_OPTIONAL, cal_tier, beds),
     CYAML_FIELD_INT("posterior_runs", CYAML_FLAG_OPTIONAL, cal_tier, posterior_runs),
+    CYAML_FIELD_INT("return_runs", CYAML_FLAG_OPTIONAL, cal_tier, return_runs),
     CYAML_FIELD_ENUM_PTR("purpose", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, demonstration, purposes,
                          CYAML_ARRAY_LEN(purposes)),
     CYAML_FIELD_END};
@@ -362,6 +363,10 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "posterior_runs", err, len, "%d must be in [0, 16]", t->posterior_runs);
     if (t->posterior_runs && !t->map_tier)
         return located(c, from, "posterior_runs", err, len, "only a tier with a map_tier has a corrected map to refine");
+    if (t->return_runs < 0 || t->return_runs > 16)
+        return located(c, from, "return_runs", err, len, "%d must be in [0, 16]", t->return_runs);
+    if (t->return_runs && !t->posterior_runs)
+        return located(c, from, "return_runs", err, len, "only a tier with posterior_runs has runs to return from");
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
 }
 
@@ -375,7 +380,7 @@ const char *cal_tier_calibration_key(const cal_tier *t)
         {"angle_rule", t->angle_rule != NULL}, {"csa_sd_percent", t->csa_sd_percent_count > 0},
         {"bound_probes", t->bound_probes != NULL}, {"map_tier", t->map_tier != NULL},
         {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL},
-        {"posterior_runs", t->posterior_runs != 0},
+        {"posterior_runs", t->posterior_runs != 0}, {"return_runs", t->return_runs != 0},
         {"turned_start_rpm", t->turned_start_rpm_count > 0}, {"turned_start_time", t->turned_start_time != 0}};
     for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k)
         if (keys[k].given) return keys[k].key;

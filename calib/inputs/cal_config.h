@@ -118,6 +118,11 @@ typedef struct cal_tier {
     /// map's own uncertainty (cal_posterior_next_run); none where its width
     /// is the data's. Absent: 0.
     int posterior_runs;
+    /// With posterior_runs: once the posterior's runs are made (one or more),
+    /// at most this many more runs at the corrected map's optimum, the loop
+    /// resumed (cal_mf_return): those runs moved the correction, and the
+    /// stage must not end on an optimum no run checked. Absent: 0.
+    int return_runs;
     /// Beds each drum candidate is run on (seeds seed, seed+1, ...), its
     /// measurements the mean over them. angle_sd_deg and csa_sd_percent stay
     /// one bed's spreads, as measured; the search divides them by sqrt(beds)

@@ -350,23 +350,39 @@ static int run_at(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_resul
 
 static int budget_of(const cal_mf_problem *p) { return p->max_expensive < CAL_MF_MAX_FINE ? p->max_expensive : CAL_MF_MAX_FINE; }
 
-int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out)
+// The loop from where out stands: a run at the corrected optimum, until one
+// agrees, the optimum comes back to a point already run, a run fails, or
+// out->n reaches budget.
+static void search_until(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out, int budget)
 {
-    memset(out, 0, sizeof *out);
-    cal_mf_optimum(cheap, NULL, p, &out->u_uncorrected, &out->v_uncorrected);
-    int budget = budget_of(p);
     while (out->n < budget) {
         double u, v;
         cal_mf_optimum(cheap, &out->correction, p, &u, &v);
         const cal_mf_point *again = already_run(out, u, v);
         if (again) {
             out->settled = 1, out->unmeasured = !measured(again, p->n_y), out->settled_noisy = noisy(p, again);
-            return 0;
+            return;
         }
-        if (run_at(cheap, p, out, u, v)) return 0;
-        if (out->agreed) return 0;
+        if (run_at(cheap, p, out, u, v)) return;
+        if (out->agreed) return;
     }
+}
+
+int cal_mf_search(const cal_mf_map *cheap, const cal_mf_problem *p, cal_mf_result *out)
+{
+    memset(out, 0, sizeof *out);
+    cal_mf_optimum(cheap, NULL, p, &out->u_uncorrected, &out->v_uncorrected);
+    search_until(cheap, p, out, budget_of(p));
     return 0;
+}
+
+int cal_mf_return(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_result *out)
+{
+    if (out->failed || more <= 0) return 0;
+    int before = out->n, budget = out->n + more < CAL_MF_MAX_FINE ? out->n + more : CAL_MF_MAX_FINE;
+    out->agreed = out->settled = out->settled_noisy = out->unmeasured = 0; // they speak of the resumed loop now
+    search_until(cheap, p, out, budget);
+    return out->n - before;
 }
 
 const char *cal_mf_refine(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_next_point next, void *ctx,

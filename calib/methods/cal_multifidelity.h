@@ -147,6 +147,14 @@ typedef int (*cal_mf_next_point)(const cal_mf_correction *c, double *u, double *
 const char *cal_mf_refine(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_next_point next, void *ctx,
                           cal_mf_result *out);
 
+/// After cal_mf_refine: the loop resumed from where out stands, up to `more`
+/// runs at the corrected map's optimum, as cal_mf_search makes them. Runs made
+/// where something else asked (the posterior) move the correction, and the
+/// optimum with it; without this the stage would end on an optimum no run
+/// checked. out->agreed, settled, settled_noisy and unmeasured then speak of
+/// this resumed loop (all 0 on entry). Returns the runs it made (0 where a run
+/// already failed, more is 0, or the optimum is a point already run).
+int cal_mf_return(const cal_mf_map *cheap, const cal_mf_problem *p, int more, cal_mf_result *out);
 /// The corrected map's optimum over the unit square (a 41 × 41 scan, then
 /// NLopt BOBYQA from its best point).
 void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *c, const cal_mf_problem *p, double *u, double *v);

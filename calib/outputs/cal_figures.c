@@ -152,7 +152,7 @@ static void convergence_collect(const cal_friction_result *r, convergence_data *
             d->map_index[d->map_points] = 0, d->mapped[d->map_points++] = k->objective;
             continue;
         }
-        int j = d->runs++, matches = k->angle_violation <= 0;
+        int j = d->runs++, matches = cal_candidate_angle_matched(k);
         d->index[j] = j + 1;
         d->matching[j] = matches ? k->objective : NAN;
         d->outside[j] = !matches ? k->objective : NAN;
@@ -207,7 +207,7 @@ static int best_others(const cal_friction_result *r, int *shown, int max)
     for (int i = 0; i < r->n; ++i) any_identified |= r->cand[i].identified && i != r->best;
     for (int i = 0; i < r->n; ++i) {
         const cal_candidate *k = &r->cand[i];
-        if (i == r->best || !(any_identified ? k->identified : k->angle_violation <= 0)) continue;
+        if (i == r->best || !(any_identified ? k->identified : cal_candidate_angle_matched(k))) continue;
         if (n == max && k->objective >= r->cand[shown[max - 1]].objective) continue;
         int at = n < max ? n++ : max - 1; // insertion into the sorted list, the worst dropped
         while (at > 0 && r->cand[shown[at - 1]].objective > k->objective) shown[at] = shown[at - 1], at--;

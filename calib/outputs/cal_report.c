@@ -474,7 +474,7 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                "corrected map put the optimum (%.0f s). Outcome: %s. The correction measured between the "
                "tiers (this tier minus the map, carried over the plane by %s, at the last run): angle %+.2f°",
             r->level[0].tier, r->level[0].runs, levels ? "runs of its own, on its own map" : "candidates",
-            r->level[0].wall_time_s, r->expensive_candidates - r->posterior_runs, r->wall_time_s,
+            r->level[0].wall_time_s, r->expensive_candidates - r->posterior_runs - r->return_runs, r->wall_time_s,
             r->two_tier_outcome ? r->two_tier_outcome : "not run", r->map_correction ? r->map_correction : "-",
             r->correction[0]);
     for (int j = 0; j < r->n_rpm; ++j) fprintf(f, ", CSA at %g rpm %+.2f points", r->rpm[j], r->correction[1 + j]);
@@ -492,6 +492,11 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                 t->posterior_runs, 100 * CAL_POSTERIOR_MAP_SHARE, r->posterior_runs,
                 r->posterior_runs_outcome ? r->posterior_runs_outcome : "not run", 100 * r->posterior_share,
                 r->posterior_share_of[0] ? r->posterior_share_of : "-");
+    if (t->return_runs > 0)
+        fprintf(f, "Then, where the posterior's runs were made, at most %d more back at the corrected map's optimum "
+                   "(those runs moved the correction, and so the optimum): the loop resumed. Made: %d; %s.\n\n",
+                t->return_runs, r->return_runs,
+                r->return_outcome ? r->return_outcome : "not resumed (no run after the loop)");
 }
 
 static void report_friction(FILE *f, const cal_friction_result *r, const cal_bounds *bounds, const cal_tier *t)
@@ -522,7 +527,7 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
           "\n|---|---|---|---|\n", f);
     int any = 0;
     for (int i = 0; i < r->n; ++i)
-        if (r->cand[i].angle_violation <= 0)
+        if (cal_candidate_angle_matched(&r->cand[i]))
             any = 1, fprintf(f, "| %.4g | %.4g | %.2f | %.3g |\n", r->cand[i].mu_s, r->cand[i].mu_r, r->cand[i].angle_deg,
                              r->cand[i].misfit);
     if (!any) fputs("| none | | | |\n", f);

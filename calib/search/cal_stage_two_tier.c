@@ -207,8 +207,11 @@ static void keep_loop(cal_friction_result *out, const cal_friction_result *cheap
         fprintf(stderr, "-- run %d at tier '%s': angle %.2f° measured%s, %.2f° predicted by the corrected map\n", i + 1,
                 tier, m->run[i].y[0], own, m->predicted[i][0]);
     }
-    fprintf(stderr, "-- %s after %d run(s) at tier '%s'", out->two_tier_outcome, m->n - out->posterior_runs, tier);
+    fprintf(stderr, "-- %s after %d run(s) at tier '%s'", out->two_tier_outcome,
+            m->n - out->posterior_runs - out->return_runs, tier);
     if (out->posterior_runs) fprintf(stderr, ", then %d where the posterior asked", out->posterior_runs);
+    if (out->return_outcome)
+        fprintf(stderr, ", then %d back at the corrected optimum (%s)", out->return_runs, out->return_outcome);
     fprintf(stderr, "; correction at the last run: angle %+.2f°\n", m->delta[0]);
     if (!m->failed && m->n > 0) add_predicted(out, cheap, cheap_noise, b, &m->correction);
 }
@@ -315,6 +318,10 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     tt.map = &map;
     out->posterior_runs_outcome = cal_mf_refine(&map, &p, t->posterior_runs, posterior_next, &tt, m);
     out->posterior_runs = m->n - loop_runs;
+    if (out->posterior_runs > 0 && t->return_runs > 0) {
+        out->return_runs = cal_mf_return(&map, &p, t->return_runs, m);
+        out->return_outcome = outcome_of(m);
+    }
     keep_loop(out, cheap, cheap_noise, &map, m, loop_outcome, t->name, tt.bounds);
     free(m);
     return cal_friction_finish(tt.search);

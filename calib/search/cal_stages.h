@@ -149,6 +149,11 @@ typedef struct cal_friction_result {
     /// stopped, and the last share of the map's uncertainty they saw.
     int posterior_runs;
     const char *posterior_runs_outcome;
+    /// Of expensive_candidates, the runs after those at the corrected
+    /// optimum (the tier's return_runs, cal_mf_return), and how that resumed
+    /// loop ended (NULL: not resumed).
+    int return_runs;
+    const char *return_outcome;
     double posterior_share;
     char posterior_share_of[48];
     /// The map the two-tier search ended with: the map tier's quadratic map in
@@ -164,6 +169,11 @@ typedef struct cal_friction_result {
 /// angle_violation, the CSA misfit and the search's objective, by the rule
 /// in r (angle_in_misfit, targets, tolerance, data).
 void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
+/// 1 when the candidate's angle is within its tolerance even at its worst: a
+/// mean that is not steady is taken unsteady_angle_sds of its own spread
+/// (unsteady_sd[0]) farther off. The one rule for "matches the angle": the
+/// ranking of candidates (cal_friction_best), the table, report and figures.
+int cal_candidate_angle_matched(const cal_candidate *k);
 /// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
 int cal_friction_best(const cal_friction_result *r);
 

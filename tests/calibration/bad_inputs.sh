@@ -106,6 +106,11 @@ expect "posterior runs out of range" "posterior_many.yaml:$(line_of "$many" 'pos
 alone=$(edit posterior_alone '/map_tier: ci$/d')
 # (the standard tier's is the last posterior_runs line; the check tiers keep their map_tier)
 expect "posterior runs without a map" "posterior_alone.yaml:$(grep -n 'posterior_runs: 2' "$alone" | tail -1 | cut -d: -f1): posterior_runs: only a tier with a map_tier" -- "$alone" "${out[@]}"
+# return_runs: a count in [0, 16], and only after posterior_runs (runs to return from).
+back=$(edit return_many 's/return_runs: 1$/return_runs: 17/')
+expect "return runs out of range" "return_many.yaml:$(line_of "$back" 'return_runs: 17'): return_runs: 17 must be in [0, 16]" -- "$back" "${out[@]}"
+back=$(edit return_alone '/posterior_runs: 2$/d')
+expect "return runs without posterior runs" "return_alone.yaml:$(line_of "$back" 'return_runs: 1$'): return_runs: only a tier with posterior_runs" -- "$back" "${out[@]}"
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"

@@ -3,11 +3,14 @@
 # docs/calibration.md). `granucal calibrate --tier check-posterior --stage granule` from scratch:
 #  - each run after the loop was asked for by the posterior, at the pair its "-- posterior:" line
 #    names, and that pair is one of the stage's candidates in simulations.csv;
-#  - the tier's candidates are the loop's runs plus those, at most max_evaluations + posterior_runs;
+#  - then (return_runs) the loop resumed: runs at the corrected optimum those runs moved, each at a
+#    point none of the earlier runs stood at;
+#  - the tier's candidates are the loop's runs plus those, at most max_evaluations + posterior_runs
+#    + return_runs;
 #  - report.md says how many were made and why they stopped, as the log does;
 #  - the same command again runs nothing and writes the same table (the posterior is deterministic);
-#  - with posterior_runs: 0 the stage re-derives from the same store with 0 simulations: the loop's
-#    runs alone, and no word of runs after it.
+#  - with return_runs: 0 the stage re-derives from the same store with 0 simulations, without the
+#    returned runs; with posterior_runs: 0 as well, the loop's runs alone, and no word of runs after it.
 #   usage: posterior_runs.sh GRANUCAL SOURCE_DIR WORK_DIR
 set -euo pipefail
 bin=$1 src=$2 work=$3
@@ -20,11 +23,16 @@ run() { # run NAME CONFIG OUT
 run first configs/calibration.yaml "$work/out"
 cp "$work/out/calibrated_parameters.csv" "$work/first.csv"
 run again configs/calibration.yaml "$work/out"
-sed 's/^    posterior_runs: 2$/    posterior_runs: 0/' configs/calibration.yaml > "$work/none.yaml"
-mkdir -p "$work/none" && cp -r "$work/out/store" "$work/none/"
-# The copied config reads its data relative to itself: point it at the shipped files.
-sed -i "s|\.\./experiments/|$src/experiments/|" "$work/none.yaml"
-run none "$work/none.yaml" "$work/none"
+# The copied configs read their data relative to themselves: point them at the shipped files.
+sed -e 's/^    return_runs: 1$/    return_runs: 0/' -e "s|\.\./experiments/|$src/experiments/|" configs/calibration.yaml \
+  > "$work/no_return.yaml"
+# (every tier's: a return_runs without posterior_runs is refused)
+sed -e 's/^    posterior_runs: 2$/    posterior_runs: 0/' -e 's/^    return_runs: [0-9]*$/    return_runs: 0/' \
+  "$work/no_return.yaml" > "$work/none.yaml"
+for v in no_return none; do
+  mkdir -p "$work/$v" && cp -r "$work/out/store" "$work/$v/"
+  run $v "$work/$v.yaml" "$work/$v"
+done
 python3 - "$work" configs/calibration.yaml <<'PY'
 import csv, re, sys
 work, config = sys.argv[1], sys.argv[2]
@@ -33,6 +41,7 @@ from checks import check, finish, tier_int  # noqa: E402
 
 max_evaluations = tier_int(config, "check-posterior", "max_evaluations")
 posterior_runs = tier_int(config, "check-posterior", "posterior_runs")
+return_runs = tier_int(config, "check-posterior", "return_runs")
 
 def deciding_pairs(out):
     with open(f"{out}/simulations.csv") as f:
@@ -40,14 +49,19 @@ def deciding_pairs(out):
 
 log = open(f"{work}/first.log").read()
 asked = [(float(a), float(b)) for a, b in re.findall(r"^-- posterior: .*one more run where it weighs most, mu_s = (\S+), mu_r = (\S+)$", log, re.M)]
-loop = re.search(r"after (\d+) run\(s\) at tier 'check-posterior'(?:, then (\d+) where the posterior asked)?", log)
+loop = re.search(r"after (\d+) run\(s\) at tier 'check-posterior'(?:, then (\d+) where the posterior asked)?"
+                 r"(?:, then (\d+) back at the corrected optimum \(([^)]*)\))?", log)
 check(loop is not None, "the log says how many runs the loop made")
-loop_runs, made = int(loop.group(1)), int(loop.group(2) or 0)
+loop_runs, made, returned = int(loop.group(1)), int(loop.group(2) or 0), int(loop.group(3) or 0)
 check(made == len(asked), f"{made} run(s) after the loop, {len(asked)} asked for by the posterior")
 check(made > 0, "the posterior asked for a run (the test can fail: a tier whose width were the data's would ask none)")
 pairs = deciding_pairs(f"{work}/out")
-check(len(pairs) == loop_runs + made <= max_evaluations + posterior_runs,
-      f"{len(pairs)} candidates at the tier = {loop_runs} of the loop + {made} asked, at most {max_evaluations} + {posterior_runs}")
+check(loop.group(3) is not None, "after the posterior's runs the log says how the loop resumed")
+check(0 < returned <= return_runs, f"{returned} run(s) back at the corrected optimum, at most {return_runs} (the test "
+      "can fail: the posterior's runs moved the optimum here, so the resumed loop has somewhere to go)")
+check(len(pairs) == loop_runs + made + returned <= max_evaluations + posterior_runs + return_runs,
+      f"{len(pairs)} candidates at the tier = {loop_runs} of the loop + {made} asked + {returned} returned, at most "
+      f"{max_evaluations} + {posterior_runs} + {return_runs}")
 for a in asked:
     check(any(abs(p[0] - a[0]) <= 5e-4 * a[0] and abs(p[1] - a[1]) <= 5e-4 * a[1] for p in pairs),
           f"the pair asked for (mu_s {a[0]}, mu_r {a[1]}) is a candidate in simulations.csv")
@@ -64,6 +78,13 @@ check(" 0 simulations run now" in again, "the same command again runs nothing")
 check(open(f"{work}/first.csv").read() == open(f"{work}/out/calibrated_parameters.csv").read(),
       "and writes the same table, byte for byte")
 
+said = re.search(r"at most (\d+) more back at the corrected map's optimum.*?Made: (\d+);", report, re.S)
+check(said is not None and int(said.group(1)) == return_runs and int(said.group(2)) == returned,
+      "report.md says how many runs the resumed loop could make and how many it made")
+no_return = open(f"{work}/no_return.log").read()
+check(" 0 simulations run now" in no_return, "return_runs: 0 re-derives from the same store with 0 simulations")
+check(len(deciding_pairs(f"{work}/no_return")) == loop_runs + made,
+      f"return_runs: 0 keeps the loop's {loop_runs} runs and the {made} asked for")
 none = open(f"{work}/none.log").read()
 check(" 0 simulations run now" in none, "posterior_runs: 0 re-derives from the same store with 0 simulations")
 check(len(deciding_pairs(f"{work}/none")) == loop_runs, f"posterior_runs: 0 keeps the loop's {loop_runs} runs alone")

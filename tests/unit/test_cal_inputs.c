@@ -566,6 +566,38 @@ static void test_friction_rule(void **state)
     assert_int_equal(cal_candidate_run_vector(&r, &r.cand[1], y, sd), 1);
 }
 
+// "Closest" when no run matches the angle, on the standard rerun's granule
+// stage (results/calibration-standard-r2/, target 34.60 ± 0.56°): run 4 steady
+// at 30.30° (3.74° past the tolerance), run 6 at 38.81° not steady, its
+// series' spread 4.64°. By its mean run 6 was 3.65° past and was chosen; at
+// its worst (2 of its spreads farther) it is 12.93° past, and run 4 is closer.
+// An unsteady mean inside the tolerance does not match the angle either,
+// unless its spread keeps it inside.
+static void test_unsteady_angle_ranked_at_worst(void **state)
+{
+    (void)state;
+    static cal_friction_result r;
+    memset(&r, 0, sizeof r);
+    r.angle_target = 34.60, r.angle_tolerance = 0.56, r.n_rpm = 1, r.n = 2;
+    r.rpm[0] = 40, r.csa_data[0] = 50, r.csa_data_sd[0] = 1;
+    const double angle[2] = {30.30, 38.81}, spread[2] = {0, 4.64};
+    for (int k = 0; k < 2; ++k) {
+        cal_candidate *c = &r.cand[k];
+        c->angle_deg = angle[k], c->unsteady_sd[0] = spread[k], c->csa[0] = 50, c->usable[0] = 1;
+        cal_candidate_score(&r, c);
+    }
+    assert_true(r.cand[1].angle_violation < r.cand[0].angle_violation); // the test can fail: by the mean, run 6
+    assert_int_equal(cal_friction_best(&r), 0);
+    r.cand[1].unsteady_sd[0] = 0; // the same mean, steady: it is closer
+    assert_int_equal(cal_friction_best(&r), 1);
+    r.cand[1].angle_deg = 34.70, r.cand[1].unsteady_sd[0] = 0.3; // inside by its mean, 0.10 + 2 × 0.30 > 0.56 at worst
+    cal_candidate_score(&r, &r.cand[1]);
+    assert_false(cal_candidate_angle_matched(&r.cand[1]));
+    r.cand[1].unsteady_sd[0] = 0.1; // 0.10 + 2 × 0.10 ≤ 0.56: matched, and the only match
+    assert_true(cal_candidate_angle_matched(&r.cand[1]));
+    assert_int_equal(cal_friction_best(&r), 1);
+}
+
 // The identified ranges (cal_friction_identify). First by hand: one speed,
 // lab spread 0.6 and tier spread 0.8 (quadrature: 1.0), angle 40 ± 2. A fits
 // exactly (χ² 0); B is 1 tolerance off the angle and 1.5 spreads off the CSA
@@ -647,6 +679,7 @@ int main(void)
         cmocka_unit_test(test_store_round_trip_and_collision_check),
         cmocka_unit_test(test_sweep_removes_only_dead_writers_temporaries),
         cmocka_unit_test(test_stiffness_rule),
+        cmocka_unit_test(test_unsteady_angle_ranked_at_worst),
         cmocka_unit_test(test_friction_rule),
         cmocka_unit_test(test_identified_ranges),
     };
