@@ -27,9 +27,11 @@ records() {
   echo "$n"
 }
 # Five kill points spread over the run: once N records are stored (0 = during the first
-# fill), 2 s later, in whatever phase that is (filling, turning, writing), SIGKILL the
-# driver and its workers; then the same command again.
-for target in 0 1 3 4 6; do
+# fill; then 1, a third, two thirds and all but two of the uninterrupted run's records, so that
+# with check-two-tier the last kills fall in the deciding tier's runs, after its map tier's), 2 s
+# later, in whatever phase that is (filling, turning, writing), SIGKILL the driver and its
+# workers; then the same command again.
+for target in 0 1 $((total / 3)) $((2 * total / 3)) $((total - 2)); do
   "$bin" "${args[@]}" --out "$work/killed" > "$work/killed.$target.log" 2>&1 &
   pid=$!
   while kill -0 "$pid" 2>/dev/null && [ "$(records)" -lt "$target" ]; do sleep 0.5; done
