@@ -415,9 +415,12 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     int tier_sd = 0;
     for (int j = 0; j < r->n_rpm; ++j) tier_sd |= r->csa_tier_sd[j] > 0;
     fprintf(f, "\nWhat the data identify: every candidate's χ² over the angle (by its tolerance) and the CSA speeds "
-               "(by the lab's spread%s); the candidates within Δχ² = %.2f of the least (one parameter's 95 %% "
-               "interval) are ones these measurements cannot tell from the best (%d of %d):\n\n",
-            tier_sd ? " and this tier's measured seed spread, in quadrature" : " only: this tier's seed spread is not "
+               "(by the lab's spread%s), each spread with the candidate's own uncertainty in quadrature (a "
+               "prediction's sd; the spread of a run's series where it did not reach steady); the candidates within "
+               "Δχ² = %.2f of the least run's (one parameter's 95 %% interval) are ones these measurements cannot "
+               "tell from the best (%d of %d). A prediction below the least run's (Δχ² < 0) fits only as well as "
+               "the map knows: it widens what is not excluded, and never sets the least:\n\n",
+            tier_sd ? " and this tier's measured seed spread" : " only: this tier's seed spread is not "
                       "measured (csa_sd_percent), so the ranges are too narrow",
             r->chi2_threshold, r->identified_count, r->n);
     fputs("| candidate | from | μs | μr | angle (°) | χ² | Δχ² | told apart |\n|---|---|---|---|---|---|---|---|\n", f);

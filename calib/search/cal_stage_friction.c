@@ -348,13 +348,24 @@ int cal_friction_best(const cal_friction_result *r)
 
 // ---- what the data identify ----------------------------------------------------
 
+// A candidate's own uncertainty in measurement j (angle, then CSA per
+// speed), beyond the tier's seed spread: a prediction's sd (its source's
+// noise and the correction's kriging sd where it stands), or the spread of a
+// run's series where its mean did not reach steady; 0 for a steady run.
+static double own_sd(const cal_candidate *k, int j) { return k->predicted ? k->predicted_sd[j] : k->unsteady_sd[j]; }
+
 // χ² against every measurement, each by its whole spread: the angle by its
 // tolerance (lab and tier), each CSA speed by the lab's and the tier's
-// spreads in quadrature.
+// spreads, and the candidate's own uncertainty (own_sd), in quadrature. A
+// prediction is no measurement: counted as exact, the standard rerun's
+// corrected map, far from its runs, read -44° at (0.325, 0.0047) where its
+// own sd was ~8°, and its guess of 30.97° at (0.775, 0.106) set the least χ²
+// against which every run that measured was "told apart".
 static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 {
-    double sum = angle_z2(r, k);
-    for (int i = 0; i < r->n_rpm; ++i) sum += csa_z2(r, k, i, r->csa_tier_sd[i]);
+    double sum = squared_z(k->angle_deg, r->angle_target, hypot(cal_friction_angle_spread(r), own_sd(k, 0)), 1);
+    for (int i = 0; i < r->n_rpm; ++i)
+        sum += squared_z(k->csa[i], r->csa_data[i], hypot(cal_friction_csa_spread(r, i), own_sd(k, 1 + i)), k->usable[i]);
     return sum;
 }
 
@@ -388,9 +399,15 @@ void cal_range_bracket(cal_range *g, double bound_lo, double bound_hi)
 void cal_friction_identify(cal_friction_result *r)
 {
     r->chi2_threshold = gsl_cdf_chisq_Qinv(0.05, 1); // 3.84
+    // The least χ² is a run's (a prediction's, where no run has one): a
+    // prediction's χ² counts its own sd, so it may fit "better" than any
+    // run only because the map does not know there; that widens what is not
+    // excluded, and must not exclude the runs that measured.
     r->chi2_least = INFINITY;
+    int runs = 0;
+    for (int i = 0; i < r->n; ++i) r->cand[i].chi2 = chi2_of(r, &r->cand[i]), runs += !r->cand[i].predicted;
     for (int i = 0; i < r->n; ++i)
-        r->cand[i].chi2 = chi2_of(r, &r->cand[i]), r->chi2_least = fmin(r->chi2_least, r->cand[i].chi2);
+        if (!runs || !r->cand[i].predicted) r->chi2_least = fmin(r->chi2_least, r->cand[i].chi2);
     r->identified_count = 0;
     for (int i = 0; i < r->n; ++i) {
         r->cand[i].identified = r->cand[i].chi2 - r->chi2_least <= r->chi2_threshold;

@@ -634,6 +634,32 @@ static void test_identified_ranges(void **state)
     r.cand[2].csa[0] = NAN;
     cal_friction_identify(&r);
     assert_true(fabs(r.cand[2].chi2 - 25) < 1e-9);
+    // A run whose mean did not reach steady counts its series' spread beside the data's: C
+    // steady again, then 2 CSA spreads off by its mean known to ± 1: 4 / (1 + 1) = 2.
+    r.cand[2].csa[0] = 52, r.cand[2].usable[0] = 1, r.cand[2].unsteady_sd[1] = 1;
+    cal_friction_identify(&r);
+    assert_true(fabs(r.cand[2].chi2 - 2) < 1e-9 && r.cand[2].identified);
+    r.cand[2].unsteady_sd[1] = 0;
+    // A prediction counts its own sd (the corrected map's) beside the data's: D, 3 tolerances off
+    // the angle (χ² 9 if exact: told apart), with an angle sd of 3 has 36 / (4 + 9) = 2.77: not
+    // told apart.
+    cal_candidate *d = &r.cand[3];
+    memset(d, 0, sizeof *d);
+    d->mu_s = 0.8, d->mu_r = 0.2, d->angle_deg = 46, d->csa[0] = 50, d->usable[0] = 1, d->predicted = 1;
+    d->predicted_sd[0] = 3, r.n = 4;
+    cal_friction_identify(&r);
+    assert_true(fabs(d->chi2 - 36.0 / 13) < 1e-9 && d->identified);
+    assert_true(r.mu_s_range.hi == 0.8);
+    d->predicted_sd[0] = 0;
+    cal_friction_identify(&r);
+    assert_true(fabs(d->chi2 - 9) < 1e-9 && !d->identified); // the test can fail: exact, it is told apart
+    // And a prediction never sets the least: A made a prediction (χ² 0), the least is B's 3.25,
+    // and C (4) is no longer told apart; D (9) is, 5.75 above.
+    r.cand[0].predicted = 1;
+    cal_friction_identify(&r);
+    assert_true(fabs(r.chi2_least - 3.25) < 1e-9);
+    assert_true(r.cand[0].identified && r.cand[1].identified && r.cand[2].identified && !d->identified);
+    r.n = 3, r.cand[0].predicted = 0;
 
     // Then the five PP candidates of the ci run (results/table3_ci/r3_misfit/
     // simulations.csv; target 39.80 ± 2.75° at 4 rpm; PP's data at 4, 40 and
