@@ -120,17 +120,18 @@ int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, d
     return 0;
 }
 
-// Speed i's CSA squared z-score against csa_spread.
-static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i, double tier_sd)
+// Speed i's CSA squared z-score against the lab's spread alone (the search's
+// misfit; the identified ranges add the tier's and the candidate's own).
+static double csa_z2(const cal_friction_result *r, const cal_candidate *k, int i)
 {
-    return squared_z(k->csa[i], r->csa_data[i], csa_spread(r, i, tier_sd), k->usable[i]);
+    return squared_z(k->csa[i], r->csa_data[i], csa_spread(r, i, 0), k->usable[i]);
 }
 
 void cal_candidate_score(const cal_friction_result *r, cal_candidate *k)
 {
     k->angle_violation = isfinite(k->angle_deg) ? fabs(k->angle_deg - r->angle_target) - r->angle_tolerance : 90;
     double sum = 0;
-    for (int i = 0; i < r->n_rpm; ++i) sum += csa_z2(r, k, i, 0);
+    for (int i = 0; i < r->n_rpm; ++i) sum += csa_z2(r, k, i);
     k->misfit = r->n_rpm ? sum / r->n_rpm : 0;
     k->objective = r->angle_in_misfit ? (angle_z2(r, k) + sum) / (r->n_rpm + 1) : k->misfit;
 }
