@@ -426,8 +426,11 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     fputs("| candidate | from | μs | μr | angle (°) | χ² | Δχ² | told apart |\n|---|---|---|---|---|---|---|---|\n", f);
     for (int i = 0; i < r->n; ++i) {
         const cal_candidate *k = &r->cand[i];
-        fprintf(f, "| %d | %s | %.4g | %.4g | %.2f | %.3g | %.3g | %s |\n", i + 1, k->origin ? k->origin : "", k->mu_s,
-                k->mu_r, k->angle_deg, k->chi2, k->chi2 - r->chi2_least, k->identified ? "no" : "yes");
+        char own[32] = ""; // the angle's own uncertainty, where the χ² counted one
+        double sd = k->predicted ? k->predicted_sd[0] : k->unsteady_sd[0];
+        if (sd > 0) snprintf(own, sizeof own, " ± %.2g", sd);
+        fprintf(f, "| %d | %s | %.4g | %.4g | %.2f%s | %.3g | %.3g | %s |\n", i + 1, k->origin ? k->origin : "", k->mu_s,
+                k->mu_r, k->angle_deg, own, k->chi2, k->chi2 - r->chi2_least, k->identified ? "no" : "yes");
     }
     fputc('\n', f);
     if (!isfinite(r->mu_s_range.lo)) return;

@@ -360,7 +360,7 @@ static double own_sd(const cal_candidate *k, int j) { return k->predicted ? k->p
 // spreads, and the candidate's own uncertainty (own_sd), in quadrature. A
 // prediction is no measurement: counted as exact, the standard rerun's
 // corrected map, far from its runs, read -44° at (0.325, 0.0047) where its
-// own sd was ~8°, and its guess of 30.97° at (0.775, 0.106) set the least χ²
+// own sd was 25°, and its guess of 30.97° at (0.775, 0.106) set the least χ²
 // against which every run that measured was "told apart".
 static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 {
