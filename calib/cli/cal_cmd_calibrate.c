@@ -613,8 +613,11 @@ static int plan_search(const run *r, plan_pass *pass, const cal_tier *t, const c
         return 0;
     }
     int *grid_run = &pass->wall_grid_run[tier_slot(r, t)];
-    if (pass->worst || !m || !*grid_run) plan_batch(r, pass, t, m, rpm, speeds, t->grid * t->grid, cost);
-    if (m && t->grid > 0) *grid_run = 1;
+    if (pass->worst || !m || !*grid_run) {
+        plan_batch(r, pass, t, m, rpm, speeds, t->grid * t->grid, cost);
+        if (cal_tier_design_corners(t)) plan_batch(r, pass, t, m, rpm, speeds, 4, cost); // the same pairs for every wall too
+    }
+    if (m && (t->grid > 0 || cal_tier_design_corners(t))) *grid_run = 1;
     int cobyla = t->max_evaluations - (!pass->worst && t->grid > 0 && t->max_evaluations > 0);
     for (int i = 0; i < cobyla; ++i) plan_batch(r, pass, t, m, rpm, speeds, 1, cost);
     if (cal_tier_bound_probes(t)) plan_batch(r, pass, t, m, rpm, speeds, 2, cost);

@@ -67,6 +67,8 @@ static const cyaml_schema_field_t tier_fields[] = {
     // _PTR: the plain ENUM macro drops CYAML_FLAG_POINTER and would write the value into the pointer itself.
     CYAML_FIELD_ENUM_PTR("bound_probes", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, bound_probes, yes_no,
                          CYAML_ARRAY_LEN(yes_no)),
+    CYAML_FIELD_ENUM_PTR("design_corners", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, design_corners, yes_no,
+                         CYAML_ARRAY_LEN(yes_no)),
     CYAML_FIELD_STRING_PTR("map_tier", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, cal_tier, map_tier, 1, 31),
     CYAML_FIELD_ENUM_PTR("map_correction", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, map_correction, corrections,
                          CYAML_ARRAY_LEN(corrections)),
@@ -378,7 +380,8 @@ const char *cal_tier_calibration_key(const cal_tier *t)
         {"stiffness_scene", t->stiffness_scene != NULL}, {"seeds", t->seeds != 0}, {"grid", t->grid != 0},
         {"max_evaluations", t->max_evaluations != 0}, {"angle_sd_deg", t->angle_sd_deg != 0},
         {"angle_rule", t->angle_rule != NULL}, {"csa_sd_percent", t->csa_sd_percent_count > 0},
-        {"bound_probes", t->bound_probes != NULL}, {"map_tier", t->map_tier != NULL},
+        {"bound_probes", t->bound_probes != NULL}, {"design_corners", t->design_corners != NULL},
+        {"map_tier", t->map_tier != NULL},
         {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL},
         {"posterior_runs", t->posterior_runs != 0}, {"return_runs", t->return_runs != 0},
         {"turned_start_rpm", t->turned_start_rpm_count > 0}, {"turned_start_time", t->turned_start_time != 0}};
@@ -392,6 +395,8 @@ int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_is_demonstration(const cal_tier *t) { return t->demonstration && *t->demonstration; }
 int cal_tier_stiffness_on_drum(const cal_tier *t) { return t->stiffness_scene && *t->stiffness_scene; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
+
+int cal_tier_design_corners(const cal_tier *t) { return t->design_corners && *t->design_corners; }
 const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n)
 {
     *n = t->stiffness_count ? t->stiffness_count : c->stiffness_count;

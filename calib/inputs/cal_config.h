@@ -103,6 +103,12 @@ typedef struct cal_tier {
     /// After the search, the best μs with μr at each search bound, so that the
     /// identified μr range says whether the data bound it (absent: true).
     int *bound_probes;
+    /// With the grid, the four corners of the search box (absent: false), so
+    /// that a map made from this tier's candidates spans the box a level
+    /// above asks it about instead of extrapolating past the grid's cell
+    /// centres (cal_stage_two_tier; the standard rerun's ci map stopped at
+    /// μs 0.325 with a bound of 0.1, and its plane read 24° high at 0.1).
+    int *design_corners;
     /// A cheaper tier that maps the friction plane first (cal_multifidelity.h):
     /// this tier then runs only where the map, corrected by the discrepancy it
     /// measures between the two, puts the optimum; max_evaluations bounds
@@ -144,6 +150,8 @@ int cal_tier_is_demonstration(const cal_tier *t);
 int cal_tier_stiffness_on_drum(const cal_tier *t);
 /// 1 if the tier probes the μr bounds after the search (the default).
 int cal_tier_bound_probes(const cal_tier *t);
+/// 1 when the tier's initial design adds the search box's corners (design_corners).
+int cal_tier_design_corners(const cal_tier *t);
 /// The tier's map_correction (kriging when absent).
 cal_mf_correction_kind cal_tier_map_correction(const cal_tier *t);
 /// The tier's CSA spread at speed index i of its rpm list (0: not measured).

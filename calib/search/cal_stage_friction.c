@@ -187,7 +187,7 @@ static int planned_candidates(const cal_tier *t)
 {
     if (t->map_tier) // the two-tier loop's budget, the posterior's and the return's (its map tier plans its own)
         return t->max_evaluations + t->posterior_runs + t->return_runs;
-    return t->grid * t->grid + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0);
+    return t->grid * t->grid + (cal_tier_design_corners(t) ? 4 : 0) + t->max_evaluations + (cal_tier_bound_probes(t) ? 2 : 0);
 }
 
 // "candidate i of at most N" (or "candidates i-j"), with the time left at the
@@ -457,6 +457,16 @@ static void evaluate_grid(search *s)
     free(mu);
 }
 
+// The search box's four corners (design_corners), simulated together: with
+// them a map made from this tier's candidates spans the whole box.
+static void evaluate_corners(search *s)
+{
+    const cal_bounds *b = bounds_of(s);
+    const double corners[4][2] = {{b->mu_s_min, b->mu_r_min}, {b->mu_s_min, b->mu_r_max},
+                                  {b->mu_s_max, b->mu_r_min}, {b->mu_s_max, b->mu_r_max}};
+    evaluate_points(s, corners, 4, "corner");
+}
+
 // After the search, the best μs with μr at each search bound: whether the
 // data bound μr on each side, or the identified range reaches the bound.
 static void probe_bounds(search *s)
@@ -587,6 +597,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     search *s = cal_friction_begin(env, c, t, angles, areas, k_n, material, gg_mu_s, gg_mu_r, out, err, len);
     if (!s) return 1;
     evaluate_grid(s);
+    if (cal_tier_design_corners(t) && !s->failed) evaluate_corners(s);
     out->nlopt_result = s->failed ? "not run" : run_cobyla(s);
     if (cal_tier_bound_probes(t)) probe_bounds(s);
     return cal_friction_finish(s);

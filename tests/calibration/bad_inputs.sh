@@ -50,6 +50,7 @@ expect "unknown angle rule" "angle_rule: 'maybe'" -- "$(edit rule 's/angle_rule:
 expect "negative CSA spread" "csa_sd_percent: -0.55 must be in [0, 50)" -- "$(edit csa_sd 's/csa_sd_percent: \[0.55,/csa_sd_percent: [-0.55,/')" "${out[@]}"
 expect "fractional --jobs" "--jobs '2.5': expected a whole number in 1..1024" -- "$work/configs/good.yaml" --jobs 2.5 "${out[@]}"
 expect "bound probes neither yes nor no" "bound_probes: Invalid ENUM value: perhaps" -- "$(edit probes 's/bound_probes: false/bound_probes: perhaps/')" "${out[@]}"
+expect "design corners neither yes nor no" "design_corners: Invalid ENUM value: perhaps" -- "$(edit corners 's/design_corners: yes/design_corners: perhaps/')" "${out[@]}"
 expect "CSA spreads not one per speed" "csa_sd_percent: 2 values for 3 speeds" -- "$(edit csa_sd_count 's/csa_sd_percent: \[0.55, 0.81, 1.37\]/csa_sd_percent: [0.55, 0.81]/')" "${out[@]}"
 expect "averaging past max_time" "average_time: 9 must be >= 0 and fit with two windows" -- "$(edit avg 's/^    max_time: 1.5/    max_time: 1.5\n    average_time: 9/')" "${out[@]}"
 expect "unknown fill method" "fill_method: 'shake': use pour or pack" -- "$(edit fillm '0,/^    max_time: 1.5/s//    max_time: 1.5\n    fill_method: shake/')" "${out[@]}"
@@ -92,7 +93,7 @@ expect "a plan over the budget" "over --budget-hours 0.001, which judges the exp
 expect "stage 1 over the budget" "over --budget-hours 0.0001, which judges the expected figure" -- "$work/configs/good.yaml" --tier ci --stage stiffness --budget-hours 0.0001 "${out[@]}"
 expect "a budget not a number" "--budget-hours 'soon'" -- "$work/configs/good.yaml" --budget-hours soon "${out[@]}"
 expect "--data without its files" "nodata/repose_angle.csv: cannot open" -- "$work/configs/good.yaml" --data "$work/nodata" "${out[@]}"
-expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci/map_tier: quick/')" "${out[@]}"
+expect "map tier of other speeds" "map_tier: 'quick' must turn the same rpm list" -- "$(edit map 's/map_tier: ci-map$/map_tier: quick/')" "${out[@]}"
 # Levels (issue 37.2): a map tier may map with another, but never round in a cycle nor onto itself;
 # each refused at the map_tier line of the first tier the check meets, with the chain it found.
 line_of() { grep -n "$2" "$1" | head -1 | cut -d: -f1; }
@@ -103,7 +104,7 @@ expect "map tiers in a cycle" "map_cycle.yaml:$(line_of "$cycle" 'map_tier: chec
 # posterior_runs (issue 35.4): a count in [0, 16], and only on a tier with a corrected map to refine.
 many=$(edit posterior_many 's/posterior_runs: 2$/posterior_runs: 17/')
 expect "posterior runs out of range" "posterior_many.yaml:$(line_of "$many" 'posterior_runs: 17'): posterior_runs: 17 must be in [0, 16]" -- "$many" "${out[@]}"
-alone=$(edit posterior_alone '/map_tier: ci$/d')
+alone=$(edit posterior_alone '/map_tier: ci-map$/d')
 # (the standard tier's is the last posterior_runs line; the check tiers keep their map_tier)
 expect "posterior runs without a map" "posterior_alone.yaml:$(grep -n 'posterior_runs: 2' "$alone" | tail -1 | cut -d: -f1): posterior_runs: only a tier with a map_tier" -- "$alone" "${out[@]}"
 # return_runs: a count in [0, 16], and only after posterior_runs (runs to return from).

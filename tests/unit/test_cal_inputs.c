@@ -166,13 +166,14 @@ static void test_shipped_config_loads(void **state)
     assert_true(cal_tier_csa_sd(cal_config_tier(c), 0) == 3.1);
     assert_int_equal(cal_tier_beds(cal_config_tier(c)), 1); // absent: one bed
     cal_config_free(c);
-    // ci's two beds; standard's map tier, its speeds the ci tier's.
+    // standard's map tier: ci's drum with two beds and the box's corners, its speeds the standard tier's.
     c = cal_config_load(path, "standard", err, sizeof err);
     if (!c) fail_msg("%s", err);
     const cal_tier *standard = cal_config_tier(c), *map = cal_config_tier_named(c, standard->map_tier);
     assert_non_null(map);
-    assert_string_equal(map->name, "ci");
+    assert_string_equal(map->name, "ci-map");
     assert_int_equal(cal_tier_beds(map), 2);
+    assert_true(cal_tier_design_corners(map) && !cal_tier_design_corners(cal_config_tier_named(c, "ci")));
     assert_int_equal(map->rpm_count, standard->rpm_count);
     // its 4 rpm drum starts turned and MSER stops it (no averaging time); the fast speeds start
     // level and are averaged 2 s
@@ -182,13 +183,13 @@ static void test_shipped_config_loads(void **state)
     assert_true(standard->turned_start_rpm[0] == 4);
     assert_true(standard->turned_start_time == 10 && cal_tier_stiffness_on_drum(standard));
     cal_config_free(c);
-    // fine-levels: three levels, lambda 512 on the standard tier's stage, itself on ci's
+    // fine-levels: three levels, lambda 512 on the standard tier's stage, itself on ci-map's
     c = cal_config_load(path, "fine-levels", err, sizeof err);
     if (!c) fail_msg("%s", err);
     const cal_tier *top = cal_config_tier(c);
     assert_int_equal(cal_tier_map_depth(c, top), 2);
     assert_string_equal(cal_tier_map_level(c, top, 1)->name, "standard");
-    assert_string_equal(cal_tier_map_level(c, top, 2)->name, "ci");
+    assert_string_equal(cal_tier_map_level(c, top, 2)->name, "ci-map");
     assert_null(cal_tier_map_level(c, top, 3));
     cal_config_free(c);
 }
@@ -275,10 +276,10 @@ static void test_bad_config_named_by_line_and_field(void **state)
     expect_config_error("stiffness: [50, 100", "stiffness: [100, 50", "stiffness"); // not increasing
     expect_config_error("max_evaluations: 1\n    # Its drum", "max_evaluations: -2\n    # Its drum",
                         "max_evaluations");                                 // in a tier's own block
-    expect_config_error("map_tier: ci", "map_tier: cheap", "map_tier");     // no such tier
-    expect_config_error("map_tier: ci", "map_tier: standard", "map_tier");  // itself
-    expect_config_error("map_tier: ci", "map_tier: quick", "map_tier");     // other speeds
-    expect_config_error("    map_tier: ci\n", "    map_tier: ci\n    map_correction: spline\n", "map_correction"); // not a kind
+    expect_config_error("map_tier: ci-map", "map_tier: cheap", "map_tier");     // no such tier
+    expect_config_error("map_tier: ci-map", "map_tier: standard", "map_tier");  // itself
+    expect_config_error("map_tier: ci-map", "map_tier: quick", "map_tier");     // other speeds
+    expect_config_error("    map_tier: ci-map\n", "    map_tier: ci-map\n    map_correction: spline\n", "map_correction"); // not a kind
     expect_config_error("  - name: ci\n", "  - name: ci\n    map_correction: kriging\n", "map_correction"); // no map
     expect_config_error("    stiffness: [5, 10, 20", "    stiffness: [5, 20, 10", "stiffness"); // a tier's, not increasing
     expect_config_error("beds: 2", "beds: 40", "beds");
