@@ -40,7 +40,8 @@ static const char synopsis[] =
     "which these measurements cannot tell apart. A wall mu_r the drum does not resolve\n"
     "shows as a range that reaches the search bound, not as one noisy point.\n"
     "A tier with `map_tier: NAME` (the standard tier) searches across two tiers: NAME's\n"
-    "whole search maps the plane, then this tier runs only where that map, corrected by\n"
+    "whole search maps the plane (the standard tier's ci-map adds the box's corners to\n"
+    "its grid: design_corners), then this tier runs only where that map, corrected by\n"
     "the discrepancy measured between the two at those runs, puts the optimum, until a\n"
     "run agrees with the corrected map within the data's noise (max_evaluations runs).\n"
     "With posterior_runs: N, up to N more runs follow, each where the posterior is\n"
@@ -48,7 +49,7 @@ static const char synopsis[] =
     "the data's (docs/calibration.md); with return_runs: M, up to M more after them\n"
     "at the corrected optimum they moved.\n"
     "Where NAME has a map_tier of its own, NAME's stage is itself two-tier (levels:\n"
-    "ci -> lambda 1000 -> lambda 512, the fine-levels tier): its runs and its corrected\n"
+    "ci-map -> lambda 1000 -> lambda 512, the fine-levels tier): its runs and its corrected\n"
     "map's predictions are the map of the level above, which corrects them only by the\n"
     "discrepancy measured at its own runs.\n"
     "\n"
@@ -452,10 +453,11 @@ static void plan_friction(run *r, const char *name, const cal_material *m)
 // in the printed plan):
 //  - a drum run ends at the steady test's first chance, not at max_time
 //    (cal_plan_turn_time);
-//  - a one-tier search runs its grid, then COBYLA, whose first point is the
-//    grid's best (already run: max_evaluations - 1 new candidates after a
-//    grid), then the two bound probes;
-//  - the wall stages of one tier share their grid: the same pairs on the same
+//  - a one-tier search runs its grid (and the box's corners with
+//    design_corners), then COBYLA, whose first point is the grid's best
+//    (already run: max_evaluations - 1 new candidates after a grid), then the
+//    two bound probes;
+//  - the wall stages of one tier share their grid and corners: the same pairs on the same
 //    bed (the granule pair frozen), run for the first material, found in the
 //    store by the others;
 //  - a two-tier stage runs all its max_evaluations at its own tier, and none of
