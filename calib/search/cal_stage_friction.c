@@ -324,11 +324,11 @@ static double ranked_violation(const cal_candidate *k)
     return k->angle_violation + unsteady_angle_sds * k->unsteady_sd[0];
 }
 
+int cal_candidate_angle_matched(const cal_candidate *k) { return ranked_violation(k) <= 0; }
+
 // Feasible candidates first, by misfit; else the least violation (an
 // unsteady angle's at worst). With the angle in the misfit: by that misfit
 // alone (an unsteady angle already costs its penalty there).
-int cal_candidate_angle_matched(const cal_candidate *k) { return ranked_violation(k) <= 0; }
-
 static int better(const cal_friction_result *r, const cal_candidate *a, const cal_candidate *b)
 {
     if (r->angle_in_misfit) return a->objective < b->objective;
