@@ -470,7 +470,26 @@ static void report_levels(FILE *f, const cal_friction_result *r, const cal_tier 
 
 // A two-tier stage: what the map tier cost, what this tier's runs measured
 // against it, and how the loop ended; with levels, each level first.
-static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tier *t)
+// How much of the search box the map tier's candidates span (the predicted
+// candidates stand where they ran): outside it the map extrapolates, and the
+// correction measured there is the map's error as much as the tiers'.
+static void report_map_span(FILE *f, const cal_friction_result *r, const cal_bounds *b)
+{
+    double s_lo = INFINITY, s_hi = -INFINITY, r_lo = INFINITY, r_hi = -INFINITY;
+    for (int i = 0; i < r->n; ++i)
+        if (r->cand[i].predicted) {
+            const cal_candidate *k = &r->cand[i];
+            s_lo = fmin(s_lo, k->mu_s), s_hi = fmax(s_hi, k->mu_s), r_lo = fmin(r_lo, k->mu_r), r_hi = fmax(r_hi, k->mu_r);
+        }
+    if (!(s_lo <= s_hi)) return;
+    int whole = s_lo <= b->mu_s_min && s_hi >= b->mu_s_max && r_lo <= b->mu_r_min && r_hi >= b->mu_r_max;
+    fprintf(f, "The map's candidates span μs %.4g–%.4g and μr %.4g–%.4g of the search box (μs %.4g–%.4g, μr "
+               "%.4g–%.4g)%s.\n\n", s_lo, s_hi, r_lo, r_hi, b->mu_s_min, b->mu_s_max, b->mu_r_min, b->mu_r_max,
+            whole ? ": all of it" : "; beyond that span the map extrapolates, and a run there measures its error as "
+                                    "much as the tiers' (`design_corners` adds the box's corners)");
+}
+
+static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tier *t, const cal_bounds *b)
 {
     if (r->n_levels > 1) report_levels(f, r, t);
     int predicted = 0;
@@ -488,6 +507,7 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                "where they stand, "
                "not runs of this tier: they enter the identified ranges, never the choice.\n\n",
             predicted, levels ? " and its predicted candidates" : "");
+    report_map_span(f, r, b);
     if (t->posterior_runs > 0)
         fprintf(f, "After the loop, at most %d more run(s) of this tier where the posterior on the corrected map is "
                    "still held wide by the map's own uncertainty: each at the posterior sample where the kriging's "
@@ -513,7 +533,7 @@ static void report_friction(FILE *f, const cal_friction_result *r, const cal_bou
     fprintf(f, "Target angle %.2f° at %g rpm", r->angle_target, r->angle_rpm);
     fprintf(f, ", tolerance ±%.2f° (lab spread and this tier's spread combined). CSA at %d speeds. ", r->angle_tolerance,
             r->n_rpm);
-    if (r->n_levels) report_two_tier(f, r, t);
+    if (r->n_levels) report_two_tier(f, r, t, bounds);
     else fprintf(f, "NLopt COBYLA: %s. %d candidates, %.0f s.\n\n", r->nlopt_result, r->n, r->wall_time_s);
     if (r->angle_in_misfit)
         fputs("Rule (`angle_rule: misfit`): the angle is one more measurement in the misfit, its z-score taken against "

@@ -66,6 +66,10 @@ for a in asked:
     check(any(abs(p[0] - a[0]) <= 5e-4 * a[0] and abs(p[1] - a[1]) <= 5e-4 * a[1] for p in pairs),
           f"the pair asked for (mu_s {a[0]}, mu_r {a[1]}) is a candidate in simulations.csv")
 report = open(f"{work}/out/report.md").read()
+# Its map tier (check: a 2 x 2 grid at the cells' centres, no corners) does not span the search box.
+span = re.search(r"The map's candidates span μs (\S+)–(\S+) and μr (\S+)–(\S+) of the search box \(μs (\S+)–(\S+),", report)
+check(span is not None and float(span.group(1)) > float(span.group(5)) and "beyond that span the map extrapolates" in report,
+      "report.md says the map's candidates stop short of the box, and that beyond them the map extrapolates")
 said = re.search(r"After the loop, at most (\d+) more run\(s\).*?Made: (\d+); ([^;]+);", report, re.S)
 check(said is not None and int(said.group(1)) == posterior_runs and int(said.group(2)) == made,
       "report.md says how many runs the posterior could ask for and how many were made")
