@@ -395,7 +395,6 @@ int cal_tier_beds(const cal_tier *t) { return t->beds > 0 ? t->beds : 1; }
 int cal_tier_is_demonstration(const cal_tier *t) { return t->demonstration && *t->demonstration; }
 int cal_tier_stiffness_on_drum(const cal_tier *t) { return t->stiffness_scene && *t->stiffness_scene; }
 int cal_tier_bound_probes(const cal_tier *t) { return !t->bound_probes || *t->bound_probes; }
-
 int cal_tier_design_corners(const cal_tier *t) { return t->design_corners && *t->design_corners; }
 const double *cal_tier_stiffness(const cal_config *c, const cal_tier *t, unsigned *n)
 {

@@ -427,7 +427,7 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     for (int i = 0; i < r->n; ++i) {
         const cal_candidate *k = &r->cand[i];
         char own[32] = ""; // the angle's own uncertainty, where the χ² counted one
-        double sd = k->predicted ? k->predicted_sd[0] : k->unsteady_sd[0];
+        double sd = cal_candidate_own_sd(k, 0);
         if (sd > 0) snprintf(own, sizeof own, " ± %.2g", sd);
         fprintf(f, "| %d | %s | %.4g | %.4g | %.2f%s | %.3g | %.3g | %s |\n", i + 1, k->origin ? k->origin : "", k->mu_s,
                 k->mu_r, k->angle_deg, own, k->chi2, k->chi2 - r->chi2_least, k->identified ? "no" : "yes");
@@ -468,8 +468,6 @@ static void report_levels(FILE *f, const cal_friction_result *r, const cal_tier 
     fputc('\n', f);
 }
 
-// A two-tier stage: what the map tier cost, what this tier's runs measured
-// against it, and how the loop ended; with levels, each level first.
 // How much of the search box the map tier's candidates span (the predicted
 // candidates stand where they ran): outside it the map extrapolates, and the
 // correction measured there is the map's error as much as the tiers'.
@@ -489,6 +487,8 @@ static void report_map_span(FILE *f, const cal_friction_result *r, const cal_bou
                                     "much as the tiers' (`design_corners` adds the box's corners)");
 }
 
+// A two-tier stage: what the map tier cost, what this tier's runs measured
+// against it, and how the loop ended; with levels, each level first.
 static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tier *t, const cal_bounds *b)
 {
     if (r->n_levels > 1) report_levels(f, r, t);

@@ -182,7 +182,7 @@ static void score(search *s, cal_candidate *k, const cal_record *rec)
     cal_candidate_score(r, k);
 }
 
-// Candidates the stage evaluates at most: the grid, COBYLA's, the bound probes.
+// Candidates the stage evaluates at most: the grid, the corners, COBYLA's, the bound probes.
 static int planned_candidates(const cal_tier *t)
 {
     if (t->map_tier) // the two-tier loop's budget, the posterior's and the return's (its map tier plans its own)
@@ -349,24 +349,21 @@ int cal_friction_best(const cal_friction_result *r)
 
 // ---- what the data identify ----------------------------------------------------
 
-// A candidate's own uncertainty in measurement j (angle, then CSA per
-// speed), beyond the tier's seed spread: a prediction's sd (its source's
-// noise and the correction's kriging sd where it stands), or the spread of a
-// run's series where its mean did not reach steady; 0 for a steady run.
-static double own_sd(const cal_candidate *k, int j) { return k->predicted ? k->predicted_sd[j] : k->unsteady_sd[j]; }
+double cal_candidate_own_sd(const cal_candidate *k, int j) { return k->predicted ? k->predicted_sd[j] : k->unsteady_sd[j]; }
 
 // χ² against every measurement, each by its whole spread: the angle by its
 // tolerance (lab and tier), each CSA speed by the lab's and the tier's
-// spreads, and the candidate's own uncertainty (own_sd), in quadrature. A
+// spreads, and the candidate's own uncertainty (cal_candidate_own_sd), in quadrature. A
 // prediction is no measurement: counted as exact, the standard rerun's
 // corrected map, far from its runs, read -44° at (0.325, 0.0047) where its
 // own sd was 25°, and its guess of 30.97° at (0.775, 0.106) set the least χ²
 // against which every run that measured was "told apart".
 static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 {
-    double sum = squared_z(k->angle_deg, r->angle_target, hypot(cal_friction_angle_spread(r), own_sd(k, 0)), 1);
+    double sum = squared_z(k->angle_deg, r->angle_target, hypot(cal_friction_angle_spread(r), cal_candidate_own_sd(k, 0)), 1);
     for (int i = 0; i < r->n_rpm; ++i)
-        sum += squared_z(k->csa[i], r->csa_data[i], hypot(cal_friction_csa_spread(r, i), own_sd(k, 1 + i)), k->usable[i]);
+        sum += squared_z(k->csa[i], r->csa_data[i], hypot(cal_friction_csa_spread(r, i), cal_candidate_own_sd(k, 1 + i)),
+                         k->usable[i]);
     return sum;
 }
 
@@ -597,7 +594,7 @@ int cal_stage_friction(cal_env *env, const cal_config *c, const cal_tier *t, con
     search *s = cal_friction_begin(env, c, t, angles, areas, k_n, material, gg_mu_s, gg_mu_r, out, err, len);
     if (!s) return 1;
     evaluate_grid(s);
-    if (cal_tier_design_corners(t) && !s->failed) evaluate_corners(s);
+    if (cal_tier_design_corners(t)) evaluate_corners(s); // nothing runs once a batch failed (evaluate_points)
     out->nlopt_result = s->failed ? "not run" : run_cobyla(s);
     if (cal_tier_bound_probes(t)) probe_bounds(s);
     return cal_friction_finish(s);

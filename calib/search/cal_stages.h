@@ -174,6 +174,12 @@ void cal_candidate_score(const cal_friction_result *r, cal_candidate *k);
 /// (unsteady_sd[0]) farther off. The one rule for "matches the angle": the
 /// ranking of candidates (cal_friction_best), the table, report and figures.
 int cal_candidate_angle_matched(const cal_candidate *k);
+/// A candidate's own uncertainty in measurement j (angle, then CSA per
+/// speed), beside the data's and the tier's spreads: a prediction's sd (its
+/// source's noise and the correction's kriging sd where it stands), or the
+/// spread of a run's series where its mean did not reach steady; 0 for a
+/// steady run. The identified ranges' χ² counts it; the report prints it.
+double cal_candidate_own_sd(const cal_candidate *k, int j);
 /// The candidate the stage's rule chooses among r->cand, -1 if none has an angle.
 int cal_friction_best(const cal_friction_result *r);
 
