@@ -107,7 +107,7 @@ typedef struct cal_tier {
     /// that a map made from this tier's candidates spans the box a level
     /// above asks it about instead of extrapolating past the grid's cell
     /// centres (cal_stage_two_tier; the standard rerun's ci map stopped at
-    /// μs 0.325 with a bound of 0.1, and its plane read 24° high at 0.1).
+    /// μs 0.325 with a bound of 0.1, and its plane read 22° high at 0.1).
     int *design_corners;
     /// A cheaper tier that maps the friction plane first (cal_multifidelity.h):
     /// this tier then runs only where the map, corrected by the discrepancy it
