@@ -127,21 +127,21 @@ static const cal_table_row *find_row(const cal_table_row *rows, int n, const cha
 
 // The value as a person reads it, with what the search ended at where the
 // data did not choose it.
-static const char *value_cell(char out[160], const cal_table_row *r)
+static const char *value_cell(char out[224], const cal_table_row *r)
 {
     char text[48];
     cal_verdict_value_text(text, sizeof text, r->value, &r->verdict);
     if (r->verdict.status == CAL_VALUE_NOT_IDENTIFIED)
-        snprintf(out, 160, "%s (any in %.3g – %.3g; the search ended at %.3g)", text, r->range.bracket_lo,
+        snprintf(out, 224, "%s (any in %.3g – %.3g; the search ended at %.3g)", text, r->range.bracket_lo,
                  r->range.bracket_hi, r->value);
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED && r->verdict.on_bound)
-        snprintf(out, 160, "%s (the search stopped on its bound %.3g)", text, r->value);
+        snprintf(out, 224, "%s (the search stopped on its bound %.3g)", text, r->value);
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
-        snprintf(out, 160, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound)", text,
-                 r->value, r->verdict.known);
+        snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound%s)", text,
+                 r->value, r->verdict.known, cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
     else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
-        snprintf(out, 160, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
-    else snprintf(out, 160, "%s", text);
+        snprintf(out, 224, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
+    else snprintf(out, 224, "%s", text);
     return out;
 }
 
@@ -164,7 +164,7 @@ static const char *posterior_cell(char out[96], const md_table *t, const cal_tab
 // One row of the Markdown table: label, material, value, status and flags, range, posterior, source.
 static void md_row(const md_table *t, const char *contact, const char *label, const cal_table_row *r, const char *source)
 {
-    char value[160], range[160], posterior[96];
+    char value[224], range[160], posterior[96];
     fprintf(t->f, "| %s | %s | %s | %s | %s%s%s%s | %s | %s | %s |\n", contact, label, r->material, value_cell(value, r),
             cal_value_status_name(r->verdict.status), r->verdict.flags[0] ? " (" : "", r->verdict.flags,
             r->verdict.flags[0] ? ")" : "", range_cell(range, r->range, r->value), posterior_cell(posterior, t, r),
@@ -738,7 +738,8 @@ static cal_outcome with_credible(const cal_outcome *o, const posteriors *post)
         if (!post->ok[i]) continue;
         const cal_posterior *q = &post->of[i];
         for (int k = 0; k < 2; ++k)
-            judged.credible[i][k] = (cal_credible){1, q->lo[k], q->hi[k], q->reaches_lower[k], q->reaches_upper[k]};
+            judged.credible[i][k] = (cal_credible){1, q->lo[k], q->hi[k], q->reaches_lower[k], q->reaches_upper[k],
+                                                     q->width[k]};
     }
     return judged;
 }

@@ -25,6 +25,14 @@ static void remove_flag(cal_verdict *v, const char *flag)
     snprintf(v->flags, sizeof v->flags, "%s", kept);
 }
 
+int cal_verdict_has_flag(const cal_verdict *v, const char *flag)
+{
+    size_t n = strlen(flag);
+    for (const char *f = v->flags; (f = strstr(f, flag)) != NULL; f += n)
+        if ((f == v->flags || f[-1] == ';') && (f[n] == '\0' || f[n] == ';')) return 1;
+    return 0;
+}
+
 static const char *open_flag(int side) { return side > 0 ? "not_excluded_to_upper_bound" : "not_excluded_to_lower_bound"; }
 
 // A value on a bound, relative to the bound's size (μr's bounds span decades).
@@ -82,16 +90,22 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
 {
     if (!c || !c->known || v->status == CAL_VALUE_NOT_RUN) return;
-    if (v->status == CAL_VALUE_ONE_SIDED && !v->on_bound && !(v->side > 0 ? c->reaches_upper : c->reaches_lower)) {
-        remove_flag(v, open_flag(v->side)); // the posterior closes the side the runs' cut leaves open
-        v->status = CAL_VALUE_CALIBRATED, v->side = 0, v->known = 0;
-    }
-    if (!outside(value, c->lo, c->hi)) return;
     // Beyond an end that runs to its search bound, the value lies between that end and the bound: the
     // posterior does not hold it off (its 2.5 % and 97.5 % points sit inside the bounds by construction).
-    if ((value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower)) return;
-    add_flag(v, "outside_credible");
-    v->status = CAL_VALUE_NOT_A_RESULT, v->side = 0;
+    int beyond_open_end = (value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower);
+    if (outside(value, c->lo, c->hi) && !beyond_open_end) {
+        if (v->status == CAL_VALUE_ONE_SIDED && !v->on_bound) remove_flag(v, open_flag(v->side)); // decides nothing now
+        add_flag(v, "outside_credible");
+        v->status = CAL_VALUE_NOT_A_RESULT, v->side = 0;
+        return;
+    }
+    if (v->status != CAL_VALUE_ONE_SIDED || v->on_bound || (v->side > 0 ? c->reaches_upper : c->reaches_lower)) return;
+    if (c->width > CAL_CREDIBLE_MAX_WIDTH) {
+        add_flag(v, "credible_wide"); // held off the bound, but not narrowed
+        return;
+    }
+    remove_flag(v, open_flag(v->side)); // the posterior closes the side the runs' cut leaves open
+    v->status = CAL_VALUE_CALIBRATED, v->side = 0, v->known = 0;
 }
 
 const char *cal_value_status_name(cal_value_status s)
@@ -234,9 +248,10 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
         if (st == CAL_VALUE_ONE_SIDED)
-            fprintf(f, ", only %s %.6g is known (%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
+            fprintf(f, ", only %s %.6g is known (%s%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
                     r->verdict.on_bound ? "the search stopped on its bound"
-                                        : "no run excludes a value from there to the search's bound");
+                                        : "no run excludes a value from there to the search's bound",
+                    cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
         fprintf(f, " (%s)\n", r->verdict.flags);
     }
 }

@@ -39,6 +39,7 @@ typedef struct cal_verdict {
     char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, not_excluded_to_lower_bound,
                       ///< not_excluded_to_upper_bound (the value off the bound, the interval no run excludes
                       ///< running to it), outside_identified, outside_not_excluded, outside_credible,
+                      ///< credible_wide (a posterior held off the open bound, too wide to close it),
                       ///< not_identified, angle_not_matched, stage_not_run, stiffness_at_cylinder_lambda (stage 1
                       ///< swept a cylinder at another λ than the drum's)
 } cal_verdict;
@@ -49,15 +50,31 @@ typedef struct cal_verdict {
 /// earlier run's stage file).
 cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched);
 
+/// The widest 95 % credible interval, as a fraction of the search range on
+/// the search's scale, that may close a side the runs leave open. A flat
+/// posterior (the data say nothing) spans 0.95 and is held off neither
+/// bound; one held off a bound by a sliver of the range still leaves most of
+/// it. A value is called chosen by the data only where its posterior has
+/// excluded at least half of the range.
+#define CAL_CREDIBLE_MAX_WIDTH 0.5
+
 /// Judge v against the friction's credible interval c: a value outside it is
 /// not a result (flag outside_credible), except beyond an end that runs to
 /// its search bound (a value on that bound: the posterior's 97.5 % point
 /// sits below the upper bound by construction). A value off the bounds that
 /// is one-sided only because the interval no run excludes reaches a bound is
-/// calibrated after all where the posterior is held off that bound: the
-/// posterior, which weighs every run and the map between them, closes the
-/// side the Δχ² cut over the runs leaves open.
+/// calibrated after all where the posterior is held off that bound and spans
+/// at most CAL_CREDIBLE_MAX_WIDTH of the range: the posterior, which weighs
+/// every run and the map between them, closes the side the Δχ² cut over the
+/// runs leaves open. Held off but wider, the value stays one-sided (flag
+/// credible_wide).
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
+
+/// Whether the verdict carries that flag.
+int cal_verdict_has_flag(const cal_verdict *v, const char *flag);
+
+/// What a credible_wide flag means, as a clause the outputs append.
+#define CAL_WIDE_TEXT "; its posterior, held off the bound, spans more than half the search range"
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);

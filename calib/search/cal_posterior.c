@@ -140,6 +140,7 @@ static void summarise(cal_posterior *out, int p, double *x, const cal_bounds *b)
     }
     out->lo[p] = mu[0], out->median[p] = mu[1], out->hi[p] = mu[2];
     out->reaches_lower[p] = q[0] <= bound_margin, out->reaches_upper[p] = q[2] >= 1 - bound_margin;
+    out->width[p] = q[2] - q[0];
 }
 
 // How far each measurement moves across each parameter's whole range, the other at (u, v).

@@ -35,6 +35,9 @@ typedef struct cal_posterior {
     /// the range, reaches both).
     double median[2], lo[2], hi[2];
     int reaches_lower[2], reaches_upper[2];
+    /// The 95 % interval's width as a fraction of the search range, on the
+    /// search's own scale (μs, log10 μr): 0.95 for a flat posterior.
+    double width[2];
     /// The chains' medians, furthest apart, in units of the search range: a
     /// posterior the chains did not explore alike says so.
     double chain_spread[2];

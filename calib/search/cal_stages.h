@@ -95,6 +95,7 @@ typedef struct cal_credible {
     int known;
     double lo, hi;
     int reaches_lower, reaches_upper; ///< the interval runs to that search bound
+    double width;                     ///< as a fraction of the search range, on the search's scale
 } cal_credible;
 
 /// One tier below a two-tier stage's own (its map tier, or a level further

@@ -7,7 +7,8 @@
 #   interval, the posterior's 95 % credible interval, the search bounds read from the run's config.yaml):
 #   a value on a bound is never 'calibrated', a value outside its own interval is 'not a result', and so is
 #   one outside its credible interval unless beyond an end that runs to within 3 % of the search range
-#   (μs linear, μr in log10) of its bound;
+#   (μs linear, μr in log10) of its bound; a posterior closes a side the runs leave open only where it is
+#   held off that bound and spans at most half the search range;
 # - calibrated_parameters.md, report.md, liggghts_parameters.in, lammps_parameters.in: the banner
 #   (DEMONSTRATION or CALIBRATION, the tier, the data's provenance); the two .in files list every
 #   friction the data did not choose (and the stiffness where stage 1 did not choose it) on a
@@ -33,6 +34,12 @@ def reaches_bounds(parameter, lo, hi, lo_bound, hi_bound):
     unit = math.log10 if parameter == 'mu_r' else (lambda x: x)
     span = unit(hi_bound) - unit(lo_bound)
     return ((unit(lo) - unit(lo_bound)) / span <= 0.03 + 1e-6, (unit(hi_bound) - unit(hi)) / span <= 0.03 + 1e-6)
+
+
+def range_fraction(parameter, lo, hi, lo_bound, hi_bound):
+    """The width of [lo, hi] as a fraction of the search range (mu_r in log10)."""
+    unit = math.log10 if parameter == 'mu_r' else (lambda x: x)
+    return (unit(hi) - unit(lo)) / (unit(hi_bound) - unit(lo_bound))
 
 
 def outside_credible(r, v, lo_bound, hi_bound, outside):
@@ -67,10 +74,12 @@ def expected_status(r, lo_bound, hi_bound):
     if open_lo or open_hi:
         if r.get('credible_min', '') == '':
             return 'one-sided'
-        reaches_lower, reaches_upper = reaches_bounds(r['parameter'], float(r['credible_min']),
-                                                      float(r['credible_max']), lo_bound, hi_bound)
+        clo, chi = float(r['credible_min']), float(r['credible_max'])
+        reaches_lower, reaches_upper = reaches_bounds(r['parameter'], clo, chi, lo_bound, hi_bound)
         if reaches_upper if open_hi else reaches_lower:
             return 'one-sided'
+        if range_fraction(r['parameter'], clo, chi, lo_bound, hi_bound) > 0.5 + 1e-6:
+            return 'one-sided'  # held off the bound, but the posterior still spans most of the range
     return 'calibrated'
 
 

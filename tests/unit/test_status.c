@@ -44,14 +44,14 @@ static void test_an_interval_open_to_a_bound_is_one_sided(void **state)
     assert_string_equal(v.flags, "not_excluded_to_upper_bound");
     assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.775, &v), "≥ 0.325");
     // Its posterior runs to the same bound (0.585 - 0.993): still one-sided.
-    cal_credible to_upper = {1, 0.585, 0.993, 0, 1};
+    cal_credible to_upper = {1, 0.585, 0.993, 0, 1, 0.453};
     cal_verdict_credible(&v, 0.775, &to_upper);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     // A posterior held off that bound closes the side: calibrated, the open interval's flag gone.
     // (The standard run's granule μr: 0.1918, not excluded 0.106 - 0.5, credible 0.098 - 0.33.)
     v = cal_verdict_friction(0.191835, range(0.191835, 0.191835, 0.105737, 0.5), 1e-5, 0.5, 1);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
-    cal_credible held_off = {1, 0.0983423, 0.329743, 0, 0};
+    cal_credible held_off = {1, 0.0983423, 0.329743, 0, 0, 0.112};
     cal_verdict_credible(&v, 0.191835, &held_off);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
     assert_int_equal(v.side, 0);
@@ -123,15 +123,15 @@ static void test_outside_its_credible_interval_is_not_a_result(void **state)
     // outside its 95 % credible interval 1.2e-5 - 0.02: not a result, whatever the runs' cut says.
     cal_verdict v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED); // by the runs' cut alone: open to the upper bound
-    cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0};
+    cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0, 0.686};
     cal_verdict_credible(&v, 0.0334, &narrow);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_string_equal(v.flags, "outside_credible");
-    // Inside it (a posterior held off the upper bound: calibrated), then with no posterior (a stage read
-    // from a stage file), nothing changes.
+    // Inside a posterior held off the upper bound (1e-3 - 0.2, 0.49 of the log range: calibrated), then
+    // with no posterior (a stage read from a stage file), nothing changes.
     v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
-    cal_credible wide = {1, 1.2e-5, 0.2, 1, 0}, none = {0};
-    cal_verdict_credible(&v, 0.0334, &wide);
+    cal_credible held_off_narrow = {1, 1e-3, 0.2, 0, 0, 0.490}, none = {0};
+    cal_verdict_credible(&v, 0.0334, &held_off_narrow);
     cal_verdict_credible(&v, 0.0334, &none);
     cal_verdict_credible(&v, 0.0334, NULL);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
@@ -139,16 +139,55 @@ static void test_outside_its_credible_interval_is_not_a_result(void **state)
     // The standard run's granule μs on its upper bound 1.0, credible 0.663 - 0.996 running to that bound: the
     // 97.5 % point of a posterior sits below the bound by construction, so it stays one-sided.
     v = cal_verdict_friction(1.0, range(1.0, 1.0, 0.775, 1.0), 0.1, 1.0, 1);
-    cal_credible to_upper = {1, 0.662998, 0.995937, 0, 1};
+    cal_credible to_upper = {1, 0.662998, 0.995937, 0, 1, 0.370};
     cal_verdict_credible(&v, 1.0, &to_upper);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     assert_string_equal(v.flags, "at_upper_bound");
     // The same bound with a posterior held off it (credible 0.3 - 0.7): the data say the bound is wrong.
-    cal_credible held_off = {1, 0.3, 0.7, 0, 0};
+    cal_credible held_off = {1, 0.3, 0.7, 0, 0, 0.444};
     cal_verdict_credible(&v, 1.0, &held_off);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_int_equal(v.side, 0);
     assert_string_equal(v.flags, "at_upper_bound;outside_credible");
+}
+
+static void test_a_wide_posterior_does_not_close_a_side(void **state)
+{
+    (void)state;
+    char text[48];
+    // The standard rerun's granule μs once read: 0.569, no run excluding anything from 0.102 up to the
+    // bound 1 (of 0.1 - 1). A posterior 0.30 - 0.93 is held off 1, but spans 0.70 of the range: it does not
+    // close that side; only μs ≥ 0.102 is known.
+    cal_verdict v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), 0.1, 1.0, 1);
+    cal_credible wide = {1, 0.30, 0.93, 0, 0, (0.93 - 0.30) / 0.9};
+    cal_verdict_credible(&v, 0.569, &wide);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_int_equal(v.side, +1);
+    assert_float_equal(v.known, 0.102, 1e-12);
+    assert_string_equal(v.flags, "not_excluded_to_upper_bound;credible_wide");
+    assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.569, &v), "≥ 0.102");
+    assert_true(cal_verdict_has_flag(&v, "credible_wide"));
+    assert_false(cal_verdict_has_flag(&v, "credible")); // a whole flag, not a part of one
+    assert_false(cal_verdict_has_flag(&v, "wide"));
+    // The same in log μr: 1.2e-5 - 0.2 held off 0.5 spans 0.90 of the decades 1e-5 - 0.5.
+    v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), 1e-5, 0.5, 1);
+    cal_credible wide_log = {1, 1.2e-5, 0.2, 1, 0, 0.898};
+    cal_verdict_credible(&v, 0.0334, &wide_log);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_string_equal(v.flags, "not_excluded_to_upper_bound;credible_wide");
+    // At the rule's edge: half the range closes the side, a hair more does not.
+    v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), 0.1, 1.0, 1);
+    cal_credible half = {1, 0.40, 0.85, 0, 0, CAL_CREDIBLE_MAX_WIDTH};
+    cal_verdict_credible(&v, 0.569, &half);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), 0.1, 1.0, 1);
+    half.width = CAL_CREDIBLE_MAX_WIDTH + 1e-3;
+    cal_verdict_credible(&v, 0.569, &half);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    // A value outside a wide posterior is still no result.
+    v = cal_verdict_friction(0.95, range(0.95, 0.95, 0.102, 1.0), 0.1, 1.0, 1);
+    cal_verdict_credible(&v, 0.95, &wide);
+    assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
 }
 
 static void test_a_stage_not_run_is_not_calibrated(void **state)
@@ -169,6 +208,7 @@ int main(void)
         cmocka_unit_test(test_outside_its_own_interval_is_not_a_result),
         cmocka_unit_test(test_nothing_excluded_is_not_identified),
         cmocka_unit_test(test_outside_its_credible_interval_is_not_a_result),
+        cmocka_unit_test(test_a_wide_posterior_does_not_close_a_side),
         cmocka_unit_test(test_a_stage_not_run_is_not_calibrated),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
