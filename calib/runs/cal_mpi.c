@@ -5,13 +5,29 @@
 #ifdef GRANUCAL_HAVE_MPI
 #include <mpi.h>
 
+#include <stdlib.h>
+
 static int started;
 
+// Whether an MPI launcher started this process: mpirun/mpiexec of Open MPI,
+// MPICH's or Intel MPI's Hydra, srun with PMI or PMIx.
+static int launched_by_mpi(void)
+{
+    static const char *const set_by_launchers[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMI_RANK", "PMIX_RANK"};
+    for (size_t i = 0; i < sizeof set_by_launchers / sizeof *set_by_launchers; ++i)
+        if (getenv(set_by_launchers[i])) return 1;
+    return 0;
+}
+
+// Run on its own, granucal is one rank and starts no MPI: Open MPI 4's
+// singleton MPI_Init forks and execs an orted daemon as a child of the
+// process, which then forks its own workers (cal_pool.c) beside it and has
+// no use for any of it.
 void cal_mpi_init(int *argc, char ***argv)
 {
     int already = 0;
     MPI_Initialized(&already);
-    if (!already) MPI_Init(argc, argv), started = 1;
+    if (!already && launched_by_mpi()) MPI_Init(argc, argv), started = 1;
 }
 void cal_mpi_finalize(void)
 {

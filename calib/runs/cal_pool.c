@@ -2,6 +2,7 @@
 // Fork pool (see cal_pool.h).
 #include "cal_pool.h"
 
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -115,6 +116,7 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
         }
         int status;
         pid_t pid = wait(&status);
+        if (pid < 0 && errno == EINTR) continue; // a signal, not the end of the children
         if (pid < 0) break;
         for (int i = 0; i < n; ++i)
             if (pids[i] == pid) {
