@@ -139,6 +139,10 @@ static const char *value_cell(char out[224], const cal_table_row *r)
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
         snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound%s)", text,
                  r->value, r->verdict.known, cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
+    else if (r->verdict.status == CAL_VALUE_BOUNDED)
+        snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between these, more than half the "
+                           "range%s)", text, r->value,
+                 cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
     else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
         snprintf(out, 224, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
     else snprintf(out, 224, "%s", text);

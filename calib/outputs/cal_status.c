@@ -38,6 +38,12 @@ static const char *open_flag(int side) { return side > 0 ? "not_excluded_to_uppe
 // A value on a bound, relative to the bound's size (μr's bounds span decades).
 static int on_bound(double value, double bound) { return fabs(value - bound) <= 1e-9 * fabs(bound); }
 
+// The width of [lo, hi] as a fraction of the search range, on the search's scale.
+static double range_fraction(double lo, double hi, double bound_lo, double bound_hi, int log_scale)
+{
+    return log_scale ? log10(hi / lo) / log10(bound_hi / bound_lo) : (hi - lo) / (bound_hi - bound_lo);
+}
+
 static int outside(double value, double lo, double hi)
 {
     // The ranges are written to 6 significant digits and read back the
@@ -46,7 +52,8 @@ static int outside(double value, double lo, double hi)
     return value < lo * (1 - slack) || value > hi * (1 + slack);
 }
 
-cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched)
+cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int log_scale,
+                                 int angle_matched)
 {
     cal_verdict v = {.status = CAL_VALUE_CALIBRATED};
     if (!isfinite(g.lo)) {
@@ -83,6 +90,12 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
         v.status = CAL_VALUE_ONE_SIDED;
         double other = v.side > 0 ? g.bracket_lo : g.bracket_hi;
         v.known = isfinite(other) ? other : value;
+    } else if (v.status == CAL_VALUE_CALIBRATED && isfinite(g.bracket_lo) &&
+               range_fraction(g.bracket_lo, g.bracket_hi, bound_lo, bound_hi, log_scale) > CAL_CALIBRATED_MAX_WIDTH) {
+        // Closed on both sides by the runs, but most of the range left: between, not chosen.
+        v.status = CAL_VALUE_BOUNDED;
+        v.between[0] = g.bracket_lo, v.between[1] = g.bracket_hi;
+        add_flag(&v, "not_excluded_wide");
     }
     return v;
 }
@@ -99,8 +112,13 @@ void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
         v->status = CAL_VALUE_NOT_A_RESULT, v->side = 0;
         return;
     }
+    if (v->status == CAL_VALUE_BOUNDED) { // the runs close both sides: a narrow posterior pins the value
+        if (c->width > CAL_CALIBRATED_MAX_WIDTH) add_flag(v, "credible_wide");
+        else remove_flag(v, "not_excluded_wide"), v->status = CAL_VALUE_CALIBRATED;
+        return;
+    }
     if (v->status != CAL_VALUE_ONE_SIDED || v->on_bound || (v->side > 0 ? c->reaches_upper : c->reaches_lower)) return;
-    if (c->width > CAL_CREDIBLE_MAX_WIDTH) {
+    if (c->width > CAL_CALIBRATED_MAX_WIDTH) {
         add_flag(v, "credible_wide"); // held off the bound, but not narrowed
         return;
     }
@@ -110,8 +128,8 @@ void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
 
 const char *cal_value_status_name(cal_value_status s)
 {
-    static const char *const names[] = {"input", "derived", "calibrated", "one-sided", "not identified", "not a result",
-                                        "stage not run"};
+    static const char *const names[] = {"input",          "derived",      "calibrated",   "one-sided", "bounded",
+                                        "not identified", "not a result", "stage not run"};
     return names[s];
 }
 
@@ -119,6 +137,7 @@ const char *cal_verdict_value_text(char *out, size_t len, double value, const ca
 {
     switch (v->status) {
     case CAL_VALUE_ONE_SIDED: snprintf(out, len, "%s %.3g", v->side > 0 ? "≥" : "≤", v->known); break;
+    case CAL_VALUE_BOUNDED: snprintf(out, len, "%.3g – %.3g", v->between[0], v->between[1]); break;
     case CAL_VALUE_NOT_IDENTIFIED: snprintf(out, len, "not identified"); break;
     case CAL_VALUE_NOT_A_RESULT: snprintf(out, len, "not a result"); break;
     default: snprintf(out, len, "%.4g", value);
@@ -140,8 +159,9 @@ static cal_table_row friction_row(const char *contact, const char *material, con
                                   cal_range g, double bound_lo, double bound_hi, int angle_matched,
                                   const cal_credible *credible)
 {
+    int log_scale = strcmp(parameter, "mu_r") == 0; // μr is searched in log10 (cal_friction_to_unit)
     cal_table_row r = {contact, "", parameter, value, "-", g,
-                       cal_verdict_friction(value, g, bound_lo, bound_hi, angle_matched)};
+                       cal_verdict_friction(value, g, bound_lo, bound_hi, log_scale, angle_matched)};
     cal_verdict_credible(&r.verdict, value, credible);
     snprintf(r.material, sizeof r.material, "%s", material);
     return r;
@@ -232,7 +252,8 @@ void cal_run_status_banner(FILE *f, const cal_run_status *s, const char *prefix)
             s->angle_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab",
             s->csa_synthetic ? "SYNTHETIC (simulated, not measured: see the data file's header)" : "from the lab");
     fprintf(f, "%sEach value's status: calibrated (chosen by the data), one-sided (a search bound the data do not "
-               "close: >= or <=), not identified (the data exclude nothing in the search range), not a result (the "
+               "close: >= or <=), bounded (the data exclude both ends but leave more than half the search range), "
+               "not identified (the data exclude nothing in the search range), not a result (the "
                "search's choice lies outside the interval its own data leave, or outside its posterior's 95 %% "
                "credible interval), stage not run (the config's value), input, derived.\n", prefix);
 }
@@ -247,11 +268,15 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         if (st == CAL_VALUE_INPUT || st == CAL_VALUE_DERIVED || st == CAL_VALUE_CALIBRATED) continue;
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
+        const char *wide = cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "";
         if (st == CAL_VALUE_ONE_SIDED)
             fprintf(f, ", only %s %.6g is known (%s%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
                     r->verdict.on_bound ? "the search stopped on its bound"
                                         : "no run excludes a value from there to the search's bound",
-                    cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
+                    wide);
+        if (st == CAL_VALUE_BOUNDED)
+            fprintf(f, ", only %.6g - %.6g is known (the runs exclude both sides, leaving more than half the search "
+                       "range%s)", r->verdict.between[0], r->verdict.between[1], wide);
         fprintf(f, " (%s)\n", r->verdict.flags);
     }
 }

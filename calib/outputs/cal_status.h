@@ -24,6 +24,9 @@ typedef enum cal_value_status {
     CAL_VALUE_CALIBRATED,     ///< chosen by the data: inside its own interval, off the search's bounds
     CAL_VALUE_ONE_SIDED,      ///< the data close one side only: the value on a search bound, or the interval no
                               ///< run excludes running to one (with no posterior held off it): "≥ x" or "≤ x"
+    CAL_VALUE_BOUNDED,        ///< the runs exclude values beyond both ends, but what they leave spans more than
+                              ///< CAL_CALIBRATED_MAX_WIDTH of the search range and no posterior narrower than that
+                              ///< holds the value: "x – y"
     CAL_VALUE_NOT_IDENTIFIED, ///< the data exclude no value of the search range
     CAL_VALUE_NOT_A_RESULT,   ///< the search's choice lies outside the interval its own data leave
     CAL_VALUE_NOT_RUN,        ///< its stage did not run: the config's value, or an unresolved stiffness sweep's
@@ -36,27 +39,32 @@ typedef struct cal_verdict {
     int on_bound;     ///< one-sided: 1 if the value itself is on that bound (0: off it, the interval reaching it)
     double known;     ///< one-sided: what the data do say, "≥ known" (side +1) or "≤ known" (side -1): the
                       ///< other end of the interval no candidate excludes (the value itself if none)
+    double between[2]; ///< bounded: the interval no candidate excludes
     char flags[192];  ///< ';'-separated, "" when none: at_lower_bound, at_upper_bound, not_excluded_to_lower_bound,
                       ///< not_excluded_to_upper_bound (the value off the bound, the interval no run excludes
                       ///< running to it), outside_identified, outside_not_excluded, outside_credible,
-                      ///< credible_wide (a posterior held off the open bound, too wide to close it),
+                      ///< not_excluded_wide (the runs close both sides but leave more than
+                      ///< CAL_CALIBRATED_MAX_WIDTH of the range), credible_wide (a posterior held off the
+                      ///< bound the runs leave open, or within their wide interval, spanning more than that),
                       ///< not_identified, angle_not_matched, stage_not_run, stiffness_at_cylinder_lambda (stage 1
                       ///< swept a cylinder at another λ than the drum's)
 } cal_verdict;
 
-/// A friction's verdict from its identified range g (cal_range; NAN lo: the
-/// stage did not run), the search's bounds, and whether its stage's chosen
-/// pair matched the angle (1, 0, or -1 unknown: the stage was read from an
-/// earlier run's stage file).
-cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int angle_matched);
+/// The widest interval, as a fraction of the search range on the search's
+/// scale (μs, log10 μr), within which the data may be said to have chosen a
+/// value: the runs' not-excluded interval or the posterior's 95 % one. A flat
+/// posterior (the data say nothing) spans 0.95 and is held off neither bound;
+/// runs excluded near both bounds, or a posterior held off one by a sliver,
+/// still leave most of the range. A value is called calibrated only where the
+/// data have excluded at least half of it.
+#define CAL_CALIBRATED_MAX_WIDTH 0.5
 
-/// The widest 95 % credible interval, as a fraction of the search range on
-/// the search's scale, that may close a side the runs leave open. A flat
-/// posterior (the data say nothing) spans 0.95 and is held off neither
-/// bound; one held off a bound by a sliver of the range still leaves most of
-/// it. A value is called chosen by the data only where its posterior has
-/// excluded at least half of the range.
-#define CAL_CREDIBLE_MAX_WIDTH 0.5
+/// A friction's verdict from its identified range g (cal_range; NAN lo: the
+/// stage did not run), the search's bounds (log_scale: μr's, searched in
+/// log10), and whether its stage's chosen pair matched the angle (1, 0, or -1
+/// unknown: the stage was read from an earlier run's stage file).
+cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int log_scale,
+                                 int angle_matched);
 
 /// Judge v against the friction's credible interval c: a value outside it is
 /// not a result (flag outside_credible), except beyond an end that runs to
@@ -64,23 +72,24 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
 /// sits below the upper bound by construction). A value off the bounds that
 /// is one-sided only because the interval no run excludes reaches a bound is
 /// calibrated after all where the posterior is held off that bound and spans
-/// at most CAL_CREDIBLE_MAX_WIDTH of the range: the posterior, which weighs
+/// at most CAL_CALIBRATED_MAX_WIDTH of the range: the posterior, which weighs
 /// every run and the map between them, closes the side the Δχ² cut over the
 /// runs leaves open. Held off but wider, the value stays one-sided (flag
-/// credible_wide).
+/// credible_wide). A bounded value is calibrated where its posterior spans at
+/// most CAL_CALIBRATED_MAX_WIDTH (and holds it); wider, it stays bounded.
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
 
 /// Whether the verdict carries that flag.
 int cal_verdict_has_flag(const cal_verdict *v, const char *flag);
 
 /// What a credible_wide flag means, as a clause the outputs append.
-#define CAL_WIDE_TEXT "; its posterior, held off the bound, spans more than half the search range"
+#define CAL_WIDE_TEXT "; its posterior spans more than half the search range"
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);
 
-/// The value as a person should read it: "0.192", "≥ 0.775", "not
-/// identified", "not a result". `out` holds at least 48 bytes.
+/// The value as a person should read it: "0.192", "≥ 0.775", "0.11 – 0.95",
+/// "not identified", "not a result". `out` holds at least 48 bytes.
 const char *cal_verdict_value_text(char *out, size_t len, double value, const cal_verdict *v);
 
 /// One row of the table (Table 3's layout) with its verdict.

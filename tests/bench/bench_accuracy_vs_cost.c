@@ -8,7 +8,7 @@
 // draws them: core-hours on x, the rolling frictions on a log y (the sliding
 // ones sit at or near their bound at every level run so far), a bar for each
 // credible interval, the value as a marker, hollow where the data did not
-// choose it (one-sided, not a result, not identified).
+// choose it (one-sided, bounded, not a result, not identified).
 // A run that took stage 1 from another run's folder lists none of it: +H adds
 // those core-hours, so that every level carries the same stage 1.
 //   usage: bench_accuracy_vs_cost OUT.png LABEL=RESULTS_DIR[+H] [LABEL=RESULTS_DIR[+H] ...]

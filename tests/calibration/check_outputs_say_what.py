@@ -8,7 +8,8 @@
 #   a value on a bound is never 'calibrated', a value outside its own interval is 'not a result', and so is
 #   one outside its credible interval unless beyond an end that runs to within 3 % of the search range
 #   (μs linear, μr in log10) of its bound; a posterior closes a side the runs leave open only where it is
-#   held off that bound and spans at most half the search range;
+#   held off that bound and spans at most half the search range; runs that close both sides but leave
+#   more than half the range, with no posterior narrower than that, make it 'bounded';
 # - calibrated_parameters.md, report.md, liggghts_parameters.in, lammps_parameters.in: the banner
 #   (DEMONSTRATION or CALIBRATION, the tier, the data's provenance); the two .in files list every
 #   friction the data did not choose (and the stiffness where stage 1 did not choose it) on a
@@ -18,7 +19,7 @@ import csv, math, sys
 
 import yaml  # python3-yaml (.ci/setup)
 
-FRICTION_STATUSES = {'calibrated', 'one-sided', 'not identified', 'not a result', 'stage not run'}
+FRICTION_STATUSES = {'calibrated', 'one-sided', 'bounded', 'not identified', 'not a result', 'stage not run'}
 
 
 def bounds(run_dir):
@@ -80,6 +81,12 @@ def expected_status(r, lo_bound, hi_bound):
             return 'one-sided'
         if range_fraction(r['parameter'], clo, chi, lo_bound, hi_bound) > 0.5 + 1e-6:
             return 'one-sided'  # held off the bound, but the posterior still spans most of the range
+        return 'calibrated'
+    # Closed on both sides by the runs: calibrated where they, or a posterior, leave at most half the range.
+    if range_fraction(r['parameter'], blo, bhi, lo_bound, hi_bound) > 0.5 + 1e-6:
+        if r.get('credible_min', '') == '' or range_fraction(r['parameter'], float(r['credible_min']),
+                                                              float(r['credible_max']), lo_bound, hi_bound) > 0.5 + 1e-6:
+            return 'bounded'
     return 'calibrated'
 
 

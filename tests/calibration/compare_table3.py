@@ -7,7 +7,7 @@
 #   compare_table3.py RUN_DIR results/paper_table3.csv TOLERANCES.csv --expect COMMITTED.md
 #
 # A row whose status (calibrated_parameters.csv) says the data did not choose its value (one-sided: on
-# a search bound, or its interval open to one; not identified, not a result, stage not run) is not
+# a search bound, or its interval open to one; bounded; not identified, not a result, stage not run) is not
 # scored as a pass or a fail of its value: its verdict is that status.
 # RUN_DIR holds calibrated_parameters.csv (value, not_excluded_min/max) and calibrated_parameters.md
 # (its Source column says whether stage 1 resolved the stiffness). Prints one row per tolerance
@@ -48,6 +48,10 @@ def judge_status(rule, paper, got):
         holds = paper >= known if upper else paper <= known
         return 'one-sided', 'only %s %.3g known: Table 3 %s it' % ('≥' if upper else '≤', known,
                                                                   'agrees with' if holds else 'lies outside')
+    if status == 'bounded':
+        lo, hi = float(got['not_excluded_min']), float(got['not_excluded_max'])
+        return 'bounded', 'only %.3g – %.3g known: Table 3 %s it' % (lo, hi, 'agrees with' if lo <= paper <= hi
+                                                                     else 'lies outside')
     if status == 'not a result' and rule == 'inside':
         return None  # the interval the data leave stands even where the search's point lies outside it
     return status, got['flags']
