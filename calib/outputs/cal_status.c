@@ -107,7 +107,9 @@ void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
     // posterior does not hold it off (its 2.5 % and 97.5 % points sit inside the bounds by construction).
     int beyond_open_end = (value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower);
     if (outside(value, c->lo, c->hi) && !beyond_open_end) {
-        if (v->status == CAL_VALUE_ONE_SIDED && !v->on_bound) remove_flag(v, open_flag(v->side)); // decides nothing now
+        // The flag that made it one-sided or bounded decides nothing now.
+        if (v->status == CAL_VALUE_ONE_SIDED && !v->on_bound) remove_flag(v, open_flag(v->side));
+        if (v->status == CAL_VALUE_BOUNDED) remove_flag(v, "not_excluded_wide");
         add_flag(v, "outside_credible");
         v->status = CAL_VALUE_NOT_A_RESULT, v->side = 0;
         return;

@@ -214,6 +214,7 @@ static void test_runs_that_leave_most_of_the_range_bound_it(void **state)
     v = cal_verdict_friction(0.9, range(0.9, 0.9, 0.1016, 0.95), 0.1, 1.0, 0, 1);
     cal_verdict_credible(&v, 0.9, &narrow);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
+    assert_string_equal(v.flags, "outside_credible");
     // In log10 μr: 1e-4 - 0.3 of 1e-5 - 0.5 is 0.74 of the decades: bounded; 0.01 - 0.3 (0.31): calibrated.
     v = cal_verdict_friction(0.05, range(0.05, 0.05, 1e-4, 0.3), 1e-5, 0.5, 1, 1);
     assert_int_equal(v.status, CAL_VALUE_BOUNDED);
