@@ -138,11 +138,11 @@ static const char *value_cell(char out[224], const cal_table_row *r)
         snprintf(out, 224, "%s (the search stopped on its bound %.3g)", text, r->value);
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
         snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound%s)", text,
-                 r->value, r->verdict.known, cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
+                 r->value, r->verdict.known, cal_verdict_wide_clause(&r->verdict));
     else if (r->verdict.status == CAL_VALUE_BOUNDED)
         snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between these, more than half the "
                            "range%s)", text, r->value,
-                 cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "");
+                 cal_verdict_wide_clause(&r->verdict));
     else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
         snprintf(out, 224, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
     else snprintf(out, 224, "%s", text);

@@ -38,10 +38,18 @@ static const char *open_flag(int side) { return side > 0 ? "not_excluded_to_uppe
 // A value on a bound, relative to the bound's size (μr's bounds span decades).
 static int on_bound(double value, double bound) { return fabs(value - bound) <= 1e-9 * fabs(bound); }
 
-// The width of [lo, hi] as a fraction of the search range, on the search's scale.
-static double range_fraction(double lo, double hi, double bound_lo, double bound_hi, int log_scale)
+const char *cal_verdict_wide_clause(const cal_verdict *v)
 {
-    return log_scale ? log10(hi / lo) / log10(bound_hi / bound_lo) : (hi - lo) / (bound_hi - bound_lo);
+    return cal_verdict_has_flag(v, "credible_wide") ? "; its posterior spans more than half the search range" : "";
+}
+
+// The width of friction `which`'s [lo, hi] as a fraction of its search range, on the search's scale.
+static double range_fraction(const cal_bounds *b, int which, double lo, double hi)
+{
+    double u[2], v[2];
+    cal_friction_to_unit(b, lo, lo, &u[0], &v[0]);
+    cal_friction_to_unit(b, hi, hi, &u[1], &v[1]);
+    return which ? v[1] - v[0] : u[1] - u[0];
 }
 
 static int outside(double value, double lo, double hi)
@@ -52,9 +60,9 @@ static int outside(double value, double lo, double hi)
     return value < lo * (1 - slack) || value > hi * (1 + slack);
 }
 
-cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int log_scale,
-                                 int angle_matched)
+cal_verdict cal_verdict_friction(double value, cal_range g, const cal_bounds *b, int which, int angle_matched)
 {
+    const double bound_lo = which ? b->mu_r_min : b->mu_s_min, bound_hi = which ? b->mu_r_max : b->mu_s_max;
     cal_verdict v = {.status = CAL_VALUE_CALIBRATED};
     if (!isfinite(g.lo)) {
         v.status = CAL_VALUE_NOT_RUN;
@@ -91,7 +99,7 @@ cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, dou
         double other = v.side > 0 ? g.bracket_lo : g.bracket_hi;
         v.known = isfinite(other) ? other : value;
     } else if (v.status == CAL_VALUE_CALIBRATED && isfinite(g.bracket_lo) &&
-               range_fraction(g.bracket_lo, g.bracket_hi, bound_lo, bound_hi, log_scale) > CAL_CALIBRATED_MAX_WIDTH) {
+               range_fraction(b, which, g.bracket_lo, g.bracket_hi) > CAL_CALIBRATED_MAX_WIDTH) {
         // Closed on both sides by the runs, but most of the range left: between, not chosen.
         v.status = CAL_VALUE_BOUNDED;
         v.between[0] = g.bracket_lo, v.between[1] = g.bracket_hi;
@@ -157,13 +165,12 @@ static cal_table_row plain_row(const char *contact, const char *parameter, doubl
     return (cal_table_row){contact, "", parameter, value, unit, no_range, {.status = status}};
 }
 
-static cal_table_row friction_row(const char *contact, const char *material, const char *parameter, double value,
-                                  cal_range g, double bound_lo, double bound_hi, int angle_matched,
-                                  const cal_credible *credible)
+// Friction `which` (0 μs, 1 μr) of a stage searched within b.
+static cal_table_row friction_row(const char *contact, const char *material, int which, double value, cal_range g,
+                                  const cal_bounds *b, int angle_matched, const cal_credible *credible)
 {
-    int log_scale = strcmp(parameter, "mu_r") == 0; // μr is searched in log10 (cal_friction_to_unit)
-    cal_table_row r = {contact, "", parameter, value, "-", g,
-                       cal_verdict_friction(value, g, bound_lo, bound_hi, log_scale, angle_matched)};
+    cal_table_row r = {contact, "", which ? "mu_r" : "mu_s", value, "-", g,
+                       cal_verdict_friction(value, g, b, which, angle_matched)};
     cal_verdict_credible(&r.verdict, value, credible);
     snprintf(r.material, sizeof r.material, "%s", material);
     return r;
@@ -193,18 +200,16 @@ int cal_table_rows(const cal_outcome *o, cal_table_row *rows)
     for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gg, k_names[k], t->k_n);
     rows[n++] = plain_row(gg, "xi", t->xi, "-", CAL_VALUE_INPUT);
     const cal_credible(*cr)[2] = o->credible;
-    rows[n++] = friction_row(gg, "", "mu_s", t->gg_mu_s, t->gg_mu_s_range, gb->mu_s_min, gb->mu_s_max,
-                             t->gg_angle_matched, &cr[0][0]);
-    rows[n++] = friction_row(gg, "", "mu_r", t->gg_mu_r, t->gg_mu_r_range, gb->mu_r_min, gb->mu_r_max,
-                             t->gg_angle_matched, &cr[0][1]);
+    rows[n++] = friction_row(gg, "", 0, t->gg_mu_s, t->gg_mu_s_range, gb, t->gg_angle_matched, &cr[0][0]);
+    rows[n++] = friction_row(gg, "", 1, t->gg_mu_r, t->gg_mu_r_range, gb, t->gg_angle_matched, &cr[0][1]);
     for (int k = 0; k < 3; ++k) rows[n++] = stiffness_row(o, gw, k_names[k], exp_boundary_stiffness(t->k_n));
     rows[n++] = plain_row(gw, "xi", t->xi, "-", CAL_VALUE_INPUT);
     for (int w = 0; w < t->n_walls && n + 2 <= CAL_TABLE_MAX_ROWS; ++w) {
         int matched = t->wall_angle_matched[w];
-        rows[n++] = friction_row(gw, t->wall_name[w], "mu_s", t->wall_mu_s[w], t->wall_mu_s_range[w], wb->mu_s_min,
-                                 wb->mu_s_max, matched, &cr[1 + w][0]);
-        rows[n++] = friction_row(gw, t->wall_name[w], "mu_r", t->wall_mu_r[w], t->wall_mu_r_range[w], wb->mu_r_min,
-                                 wb->mu_r_max, matched, &cr[1 + w][1]);
+        rows[n++] = friction_row(gw, t->wall_name[w], 0, t->wall_mu_s[w], t->wall_mu_s_range[w], wb, matched,
+                                 &cr[1 + w][0]);
+        rows[n++] = friction_row(gw, t->wall_name[w], 1, t->wall_mu_r[w], t->wall_mu_r_range[w], wb, matched,
+                                 &cr[1 + w][1]);
     }
     return n;
 }
@@ -270,7 +275,7 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         if (st == CAL_VALUE_INPUT || st == CAL_VALUE_DERIVED || st == CAL_VALUE_CALIBRATED) continue;
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
-        const char *wide = cal_verdict_has_flag(&r->verdict, "credible_wide") ? CAL_WIDE_TEXT : "";
+        const char *wide = cal_verdict_wide_clause(&r->verdict);
         if (st == CAL_VALUE_ONE_SIDED)
             fprintf(f, ", only %s %.6g is known (%s%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
                     r->verdict.on_bound ? "the search stopped on its bound"

@@ -60,11 +60,11 @@ typedef struct cal_verdict {
 #define CAL_CALIBRATED_MAX_WIDTH 0.5
 
 /// A friction's verdict from its identified range g (cal_range; NAN lo: the
-/// stage did not run), the search's bounds (log_scale: μr's, searched in
-/// log10), and whether its stage's chosen pair matched the angle (1, 0, or -1
-/// unknown: the stage was read from an earlier run's stage file).
-cal_verdict cal_verdict_friction(double value, cal_range g, double bound_lo, double bound_hi, int log_scale,
-                                 int angle_matched);
+/// stage did not run), its stage's search bounds b and which friction it is
+/// (0 μs, 1 μr: widths on the search's own scale, cal_friction_to_unit), and
+/// whether its stage's chosen pair matched the angle (1, 0, or -1 unknown:
+/// the stage was read from an earlier run's stage file).
+cal_verdict cal_verdict_friction(double value, cal_range g, const cal_bounds *b, int which, int angle_matched);
 
 /// Judge v against the friction's credible interval c: a value outside it is
 /// not a result (flag outside_credible), except beyond an end that runs to
@@ -82,8 +82,9 @@ void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
 /// Whether the verdict carries that flag.
 int cal_verdict_has_flag(const cal_verdict *v, const char *flag);
 
-/// What a credible_wide flag means, as a clause the outputs append.
-#define CAL_WIDE_TEXT "; its posterior spans more than half the search range"
+/// The clause the outputs append to a value flagged credible_wide ("; its
+/// posterior spans more than half the search range"), "" otherwise.
+const char *cal_verdict_wide_clause(const cal_verdict *v);
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);

@@ -29,17 +29,22 @@ def bounds(run_dir):
     return {(block, k): float(v) for block in ('granule', 'wall') for k, v in config[block].items()}
 
 
+def search_scale(parameter):
+    """The search's own scale: mu_r in log10, mu_s linear."""
+    return math.log10 if parameter == 'mu_r' else (lambda x: x)
+
+
 def reaches_bounds(parameter, lo, hi, lo_bound, hi_bound):
     """Whether an interval [lo, hi] runs to within 3 % of the search range (mu_r in log10) of each bound:
     (reaches the lower, reaches the upper). Also twin_coverage.py's rule."""
-    unit = math.log10 if parameter == 'mu_r' else (lambda x: x)
+    unit = search_scale(parameter)
     span = unit(hi_bound) - unit(lo_bound)
     return ((unit(lo) - unit(lo_bound)) / span <= 0.03 + 1e-6, (unit(hi_bound) - unit(hi)) / span <= 0.03 + 1e-6)
 
 
 def range_fraction(parameter, lo, hi, lo_bound, hi_bound):
     """The width of [lo, hi] as a fraction of the search range (mu_r in log10)."""
-    unit = math.log10 if parameter == 'mu_r' else (lambda x: x)
+    unit = search_scale(parameter)
     return (unit(hi) - unit(lo)) / (unit(hi_bound) - unit(lo_bound))
 
 
