@@ -11,9 +11,11 @@ rm -rf "$work" && mkdir -p "$work"
 args=("$src/configs/calibration.yaml" --tier quick --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4
       --seeds 101 --jobs 1)
 export OMP_NUM_THREADS=1
-"$bin" synthesize "${args[@]}" --out "$work/made" 2> "$work/made.log"
-"$bin" synthesize "${args[@]}" --out "$work/reused" --reuse "$work/made/store" 2> "$work/reused.log"
 fail() { echo "FAIL: $*"; exit 1; }
+# A synthesize that stops: its exit code and the end of its log (gone with the work folder).
+synthesize() { local log=$1 rc=0; shift; "$bin" synthesize "$@" 2> "$log" || rc=$?; [ $rc -eq 0 ] || fail "synthesize stopped (exit $rc): $(tail -20 "$log")"; }
+synthesize "$work/made.log" "${args[@]}" --out "$work/made"
+synthesize "$work/reused.log" "${args[@]}" --out "$work/reused" --reuse "$work/made/store"
 made_runs=$(ls "$work/made/store" | wc -l)
 [ "$made_runs" -ge 2 ] || fail "the first synthesize stored $made_runs runs"
 # Progress lines ("[lining] ... rpm: ...") are printed only for simulations run here.

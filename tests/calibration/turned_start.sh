@@ -17,7 +17,9 @@ bin=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 export OMP_NUM_THREADS=1
 fail() { echo "FAIL: $*"; exit 1; }
-run() { "$bin" calibrate "$src/configs/calibration.yaml" --tier check-turned --out "$work/out" "$@" 2>> "$work/log"; }
+# A granucal that stops says why in its log: shown with the failure (the log is gone with the work folder).
+stopped() { echo "FAIL: granucal $1 stopped with exit code $2; the end of its log:"; tail -40 "$work/log"; exit 1; }
+run() { "$bin" calibrate "$src/configs/calibration.yaml" --tier check-turned --out "$work/out" "$@" 2>> "$work/log" || stopped "calibrate $*" $?; }
 store=$work/out/store
 # The numbers a record holds (not its wall times or writer).
 numbers() { grep -E '^(status|angle_deg|angle_sd_deg|csa_percent|csa_sd_percent|steady|simulated_time_s|particle_steps|dt_s):' "$1"; }
@@ -67,7 +69,8 @@ done
 sed -e 's|\.\./experiments/data/|'"$src"'/experiments/data/|' \
     -e '/name: check-turned/,/name: standard/ { s/    beds: 2/    beds: 1/; s/    max_evaluations: 0/    max_evaluations: 2/ }' \
   "$src/configs/calibration.yaml" > "$work/one_bed.yaml"
-"$bin" calibrate "$work/one_bed.yaml" --tier check-turned --out "$work/one" --stage granule --jobs 2 2>> "$work/log"
+"$bin" calibrate "$work/one_bed.yaml" --tier check-turned --out "$work/one" --stage granule --jobs 2 2>> "$work/log" ||
+  stopped "calibrate one_bed.yaml" $?
 one=$(grep -l "rpm=4 " "$work/one/store"/*.yaml)
 [ "$(echo "$one" | wc -l)" -ge 7 ] || fail "one bed: want at least 7 records at 4 rpm (6 candidates and a COBYLA step)"
 [ "$(ls "$work/one/store"/*.start.h5 | wc -l)" -eq 1 ] || fail "one bed: want one turned bed"
