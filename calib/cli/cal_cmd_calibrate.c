@@ -17,6 +17,7 @@
 #include "cal_mpi.h"
 #include "cal_options.h"
 #include "cal_plan.h"
+#include "cal_pool.h"
 #include "cal_report.h"
 #include "exp_atomic_file.h"
 #include "exp_common.h"
@@ -136,7 +137,10 @@ static int parse_options(int argc, char **argv, options *o)
                         "the grid's best; the wall stages share "
                         "one grid; a two-tier stage runs its max_evaluations; k_n is stage 1's choice where its "
                         "cylinders are already in OUT/store, else the config's. Worst case: max_time, every "
-                        "evaluation, the stiffest k_n. Records already in OUT/store are not subtracted. "
+                        "evaluation, the stiffest k_n. Records already in OUT/store are not subtracted there; where "
+                        "OUT/store exists, a last line (== left) replays the stages on it, running and writing "
+                        "nothing, and says where a run would resume (the step, the records found, the runs of the "
+                        "next batch missing) and the expected cost left: each step's expected runs less those found. "
                         "tests/calibration/plan_vs_committed.sh holds the expected figures within 30 % of what the "
                         "committed standard run (results/calibration-standard/) took."),
     };
@@ -315,6 +319,14 @@ static int prepare(run *r)
     return cal_mpi_rank() == 0 ? keep_inputs(r) : 0;
 }
 
+// A stage's pair for later stages run alone: written by rank 0, and never by a
+// plan's replay of the store (which writes nothing).
+static int save_stage(run *r, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2])
+{
+    if (cal_mpi_rank() != 0 || r->env.store_only) return 0;
+    return write_stage(r->out, name, k_n, mu_s, mu_r, ranges, r->err, sizeof r->err);
+}
+
 static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }
 
 static int stage_stiffness(run *r, double *k_n, const char **source)
@@ -333,11 +345,11 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
             fprintf(stderr, "stage 1: the CN of the softest candidate is within the noise of the stiff limit: the sweep "
                             "does not resolve the stiffness at this tier; using the config's k_n = %g N/m\n", r->c->k_n);
             *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
-            return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
+            return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL);
         }
         *k_n = r->stiffness.chosen_k, r->table.k_calibrated = 1;
         *source = drum ? "stage 1 (the drum's poured bed, Fig. 12)" : "stage 1 (poured cylinder, Fig. 12)";
-        return cal_mpi_rank() == 0 && write_stage(r->out, "stiffness", *k_n, NAN, NAN, NULL, r->err, sizeof r->err);
+        return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL);
     }
     stage_file s;
     int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
@@ -388,7 +400,7 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
         *source = friction_source(r->granule, sources);
         r->table.gg_angle_matched = cal_candidate_angle_matched(&r->granule->cand[r->granule->best]);
         const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
-        return cal_mpi_rank() == 0 && write_stage(r->out, "granule", k_n, *mu_s, *mu_r, ranges, r->err, sizeof r->err);
+        return save_stage(r, "granule", k_n, *mu_s, *mu_r, ranges);
     }
     stage_file s;
     int got = read_stage(r->out, "granule", &s, r->err, sizeof r->err);
@@ -705,6 +717,99 @@ static void print_plan(const run *r, const plan *p)
             CAL_PLAN_HISTORY_MIN, mser, p->k_expected, p->k_source, p->k_worst, CAL_PLAN_RATE, r->out);
 }
 
+// ---- what is left: the stages replayed from OUT/store (--plan) ----------------------------
+//
+// A calibration is deterministic given its records, so replaying its stages on
+// the store alone, running nothing, ends exactly where the run would resume.
+// The replay runs in a forked child (cal_pool_probe): its stages' memory,
+// progress and lines stay there; it writes nothing (env.store_only).
+
+typedef struct replay_outcome {
+    int stopped; ///< the store ends inside the calibration (else it holds all of it)
+    int current; ///< the progress stage it ended in
+    int missing; ///< runs of the batch it ended at that the store lacks
+    int done[CAL_PROGRESS_MAX_STAGES]; ///< each stage's records found
+    double eta_expected_s, eta_bound_s; ///< the time left at the stored runs' own costs (cal_progress)
+} replay_outcome;
+
+static int replay_in_child(void *ctx, void *result)
+{
+    run *r = ctx;
+    replay_outcome *o = result;
+    r->env.store_only = 1, r->env.use_fork = 0, r->env.store_missing = 0;
+    snprintf(r->env.store, sizeof r->env.store, "%s/store", r->out);
+    double k_n, mu_s, mu_r;
+    const char *k_source, *gg_source;
+    o->stopped = stage_stiffness(r, &k_n, &k_source) || stage_granule(r, k_n, &mu_s, &mu_r, &gg_source) ||
+                 stage_walls(r, k_n, mu_s, mu_r);
+    if (o->stopped && r->env.store_missing == 0) return 1; // an error of its own, not the store's end
+    o->current = r->progress.current, o->missing = r->env.store_missing;
+    for (int k = 0; k < r->progress.n_stages; ++k) o->done[k] = r->progress.stage[k].done;
+    o->eta_expected_s = cal_progress_expected_eta_s(&r->progress), o->eta_bound_s = cal_progress_eta_s(&r->progress);
+    return 0;
+}
+
+// Runs step k of the plan has left after the replay: none before the stage it
+// ended in; there, its expected count less the records found (at least the
+// batch it ended at); after it, the expected count.
+static int step_runs_left(const run *r, const plan *p, int k, const replay_outcome *o)
+{
+    if (!o->stopped) return 0;
+    int j = 0;
+    while (j < r->progress.n_stages && strcmp(r->progress.stage[j].name, p->name[k]) != 0) ++j;
+    if (j < o->current) return 0;
+    int left = p->step[k].expected.runs - o->done[j];
+    return j == o->current && left < o->missing ? o->missing : left > 0 ? left : 0;
+}
+
+// Where the store ends and what is left: each step's runs left at the plan's
+// expected cost per run, and the time left at the stored runs' own costs.
+static void print_left(const run *r, const plan *p, const replay_outcome *o)
+{
+    int found = 0;
+    for (int k = 0; k < r->progress.n_stages; ++k) found += o->done[k];
+    if (!o->stopped) {
+        fprintf(stderr, "== left: nothing; %s/store holds every simulation of this calibration (%d found): a run "
+                        "re-derives its outputs from it\n", r->out, found);
+        return;
+    }
+    cal_plan_cost left = {0};
+    for (int k = 0; k < p->n; ++k) {
+        int runs = step_runs_left(r, p, k, o);
+        const cal_plan_cost *e = p->step[k].expected.runs > 0 ? &p->step[k].expected : &p->step[k].worst;
+        if (runs == 0 || e->runs == 0) continue;
+        left.runs += runs, left.core_s += e->core_s * runs / e->runs, left.wall_s += e->wall_s * runs / e->runs;
+    }
+    char e[128], measured[160] = "";
+    cal_plan_describe(&left, r->env.workers * cal_mpi_size(), e, sizeof e);
+    if (isfinite(o->eta_expected_s) && isfinite(o->eta_bound_s)) {
+        char expected[32], bound[32];
+        cal_progress_format_duration(o->eta_expected_s, expected, sizeof expected);
+        cal_progress_format_duration(o->eta_bound_s, bound, sizeof bound);
+        snprintf(measured, sizeof measured, "; at the stored runs' own wall times, %s (at most %s)", expected, bound);
+    }
+    fprintf(stderr, "== left: %s/store holds this calibration up to step %d of %d (%s), %d simulation(s) found, %d "
+                    "of the next batch missing. Expected left: %d simulations, %s (each step's expected runs less "
+                    "those found, at the plan's cost per run)%s. What the search does from there, only running it "
+                    "shows.\n",
+            r->out, o->current + 1, r->progress.n_stages, o->current >= 0 ? r->progress.stage[o->current].name : "-",
+            found, o->missing, left.runs, e, measured);
+}
+
+// --plan on a store that holds part of the calibration: where it would resume, and what is left.
+static void plan_left(run *r, const plan *p)
+{
+    char store[1100];
+    snprintf(store, sizeof store, "%s/store", r->out);
+    if (cal_mpi_size() > 1 || access(store, F_OK) != 0) return; // nothing stored (or ranks, which must not fork)
+    replay_outcome *o = calloc(1, sizeof *o);
+    if (!o) return;
+    if (cal_pool_probe(replay_in_child, r, o, sizeof *o) == 0) print_left(r, p, o);
+    else fprintf(stderr, "== left: not known: replaying %s stopped on an error (a damaged record?); the run itself "
+                         "says which\n", store);
+    free(o);
+}
+
 // The plan printed; refused if one simulation per worker cannot fit the
 // memory free, or if the EXPECTED wall time is over --budget-hours.
 static int check_predicted_cost(run *r)
@@ -720,6 +825,7 @@ static int check_predicted_cost(run *r)
     if (failed) return free(p), 1;
     print_plan(r, p);
     for (int k = 0; k < p->n; ++k) cal_progress_expect(&r->progress, p->name[k], p->step[k].expected.runs);
+    if (r->opt.plan_only) plan_left(r, p);
     int parallel = r->env.workers * cal_mpi_size();
     double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);
     char e[128], w[128];

@@ -820,6 +820,20 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
     free(level), free(turned);
 }
 
+// A record of the store: 0 found, 1 missing, -1 an error. Store-only, a damaged
+// record is an error, not moved aside: a plan changes nothing.
+static int look_up(const cal_env *env, const char *key, cal_record *out, char *err, size_t len)
+{
+    return env->store_only ? cal_store_get(env->store, key, out, err, len) : cal_store_lookup(env->store, key, out, err, len);
+}
+
+// Store-only, a batch with n runs missing: the evaluation ends here (an error).
+static int store_ends(cal_env *env, int n, char *err, size_t len)
+{
+    env->store_missing = n;
+    return exp_fail(err, len, "the store ends here: %d run(s) of this batch not in %s", n, env->store), 1;
+}
+
 // A record found in the store: a simulation done, at the cost it had; then released.
 static void count_stored(cal_env *env, cal_run_kind kind, cal_record *r)
 {
@@ -850,11 +864,12 @@ int cal_drum_evaluate_many(cal_env *env, const cal_drum_case *cases, int n_cases
     for (int c = 0; c < n_cases && !bad; ++c)
         for (int k = 0; k < n && !bad; ++k) {
             cal_drum_key(&cases[c], rpm[k], b.keys[c * n + k], sizeof b.keys[0]);
-            int got = cal_store_lookup(env->store, b.keys[c * n + k], &out[c * n + k], err, len);
+            int got = look_up(env, b.keys[c * n + k], &out[c * n + k], err, len);
             bad = got < 0;
             if (got == 1) missing[n_missing++] = (drum_run){c, k};
             if (got == 0) count_stored(env, drum_kind(env), &out[c * n + k]);
         }
+    if (!bad && n_missing > 0 && env->store_only) bad = store_ends(env, n_missing, err, len);
     if (!bad && n_missing > 0) run_missing_drum(&b, missing, n_missing);
     cal_mpi_barrier(); // every rank's records are on the shared store now
     int read = 0;
@@ -926,12 +941,13 @@ int cal_bed_evaluate(cal_env *env, const cal_bed_case *cases, int n, cal_record 
     cal_mpi_barrier();
     for (int k = 0; k < n && !bad; ++k) {
         cal_bed_key(&cases[k], keys[k], sizeof keys[k]);
-        int got = cal_store_lookup(env->store, keys[k], &out[k], err, len);
+        int got = look_up(env, keys[k], &out[k], err, len);
         bad = got < 0;
         missing[k] = got == 1;
         if (got == 1 && n_missing++ % cal_mpi_size() == cal_mpi_rank()) todo[n_todo++] = k, missing[k] = 0;
         if (got == 0) count_stored(env, CAL_RUN_CYLINDER, &out[k]);
     }
+    if (!bad && n_missing > 0 && env->store_only) bad = store_ends(env, n_missing, err, len);
     bed_batch b = {env, cases, todo, keys};
     if (!bad && n_todo > 0) cal_pool_run(n_todo, pour_one, poured, &b, env->workers, env->use_fork);
     cal_mpi_barrier();

@@ -28,6 +28,12 @@ typedef struct cal_env {
     double checkpoint_every_s;
     unsigned long long simulations_run; ///< by this process (the rest came from the store)
     cal_progress *progress;             ///< the whole calibration's, or NULL (a study, a single run)
+    /// Read the store, run nothing (a plan replaying a resumed run): the first
+    /// batch with a record missing ends the evaluation with an error, and
+    /// `store_missing` says how many of its runs were missing. Nothing is
+    /// written: not a failed record, and a damaged one is not moved aside.
+    int store_only;
+    int store_missing;
     int mapping;                        ///< the level running in a two-tier stage: 0 the tier's own, 1
                                         ///< its map tier, 2 that tier's map tier...: its drum runs are
                                         ///< counted by level (cal_progress_drum_kind), its stage named

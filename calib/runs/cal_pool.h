@@ -11,6 +11,8 @@
 #ifndef CAL_POOL_H
 #define CAL_POOL_H
 
+#include <stddef.h>
+
 /// Runs task i; returns 0 on success. In a child, its return is the exit code.
 typedef int (*cal_task_fn)(int i, void *ctx);
 /// Called in the parent when task i ends: `code` is its exit code, or
@@ -27,5 +29,12 @@ int cal_pool_run(int n, cal_task_fn task, cal_done_fn done, void *ctx, int worke
 /// samples. Returns the threads it runs on from now if this call added some,
 /// else 0 (nothing granted since, or not a worker).
 int cal_pool_take_granted_cores(void);
+
+/// Run fn(ctx, result) in a forked child whose stdout and stderr go to
+/// /dev/null, and copy the `size` bytes it leaves in `result` back here:
+/// whatever fn does to memory, prints or leaks stays in the child (a plan's
+/// replay of a calibration from its store). Returns 0 if fn returned 0 and
+/// every byte came back; else 1, with `result` unspecified.
+int cal_pool_probe(int (*fn)(void *ctx, void *result), void *ctx, void *result, size_t size);
 
 #endif

@@ -107,7 +107,7 @@ static const char *uncosted_kind(const cal_progress *p)
     return "";
 }
 
-static void format_duration(double s, char *out, size_t len)
+void cal_progress_format_duration(double s, char *out, size_t len)
 {
     if (s < 90) snprintf(out, len, "%.0f s", s);
     else if (s < 5400) snprintf(out, len, "%.0f min", s / 60);
@@ -126,7 +126,7 @@ void cal_progress_describe(const cal_progress *p, char *out, size_t len)
     double eta = cal_progress_eta_s(p), expected = cal_progress_expected_eta_s(p);
     if (isfinite(eta)) {
         char d[32], e[32];
-        format_duration(eta, d, sizeof d), format_duration(expected, e, sizeof e);
+        cal_progress_format_duration(eta, d, sizeof d), cal_progress_format_duration(expected, e, sizeof e);
         // The expected time beside the bound only where they differ as printed.
         if (isfinite(expected) && strcmp(d, e) != 0) snprintf(left, sizeof left, "~%s left expected, ≤ %s", e, d);
         else snprintf(left, sizeof left, "≤ %s left", d);

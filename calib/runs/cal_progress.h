@@ -81,6 +81,9 @@ double cal_progress_eta_s(const cal_progress *p);
 /// has none left), NAN while a kind still to run has no cost.
 double cal_progress_expected_eta_s(const cal_progress *p);
 
+/// A duration as progress lines print it: "45 s", "12 min", "3.4 h".
+void cal_progress_format_duration(double s, char *out, size_t len);
+
 /// "step 2 of 5 (granule), 14 of ≤ 86 simulations, ≤ 1.2 h left" (or
 /// "time left after the first drum run"); empty when p is NULL or unplanned.
 void cal_progress_describe(const cal_progress *p, char *out, size_t len);

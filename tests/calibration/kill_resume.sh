@@ -42,6 +42,13 @@ for target in 0 1 $((total / 3)) $((2 * total / 3)) $((total - 2)); do
   echo "killed once ${target}+ records were stored, 2 s later: $(records) stored"
 done
 before=$(records)
+# --plan replays the killed store (running nothing, writing nothing) and says where the run resumes.
+left() { "$bin" "${args[@]}" --out "$work/killed" --plan 2>&1 | grep '^== left:' || echo "(no left line)"; }
+store_sums() { (cd "$work/killed/store" && find . -type f | sort | xargs md5sum); }
+sums=$(store_sums)
+left_killed=$(left)
+[ "$(store_sums)" = "$sums" ] || { echo "--plan changed the store"; exit 1; }
+echo "plan on the killed store: $left_killed"
 stamp=$(mktemp)
 "$bin" "${args[@]}" --out "$work/killed" > "$work/resume.log" 2>&1 || { cat "$work/resume.log"; exit 1; }
 diff "$whole/calibrated_parameters.csv" "$work/killed/calibrated_parameters.csv"
@@ -49,6 +56,19 @@ ran=$(sed -n 's/.*; \([0-9]*\) simulations run now.*/\1/p' "$work/resume.log")
 echo "resume: ${before} of ${total} records were stored before it; it ran ${ran}"
 [ "$before" -gt 0 ] || { echo "no record survived the kills: the test did not test resuming"; exit 1; }
 [ "$ran" -eq $((total - before)) ] || { echo "the resume reran stored simulations"; exit 1; }
+# The replay ended where the resume had to run: at a batch missing at least one run and at most what
+# the resume ran; on the finished store it finds every record use that simulations.csv lists.
+missing=$(echo "$left_killed" | sed -n 's/.* found, \([0-9]*\) of the next batch missing.*/\1/p')
+if [ "$ran" -gt 0 ]; then
+  [ -n "$missing" ] && [ "$missing" -ge 1 ] && [ "$missing" -le "$ran" ] ||
+    { echo "the plan's replay of the killed store ($left_killed) does not match the resume, which ran $ran"; exit 1; }
+else
+  echo "$left_killed" | grep -q '^== left: nothing' || { echo "nothing was left to run, the plan said: $left_killed"; exit 1; }
+fi
+uses=$(($(wc -l < "$work/killed/simulations.csv") - 1))
+left_done=$(left)
+echo "$left_done" | grep -q "^== left: nothing; .* ($uses found)" ||
+  { echo "on the finished store the plan should find all $uses record uses of simulations.csv: $left_done"; exit 1; }
 # Stored records were not rewritten by the resume.
 changed=$(find "$work/killed/store" -name '*.yaml' ! -newer "$stamp" | wc -l)
 [ "$changed" -ge "$before" ] || { echo "stored records were rewritten"; exit 1; }
@@ -58,4 +78,4 @@ for f in config.yaml:configs/calibration.yaml repose_angle.csv:experiments/data/
          occupied_area.csv:experiments/data/occupied_area.csv; do
   cmp "$work/killed/${f%%:*}" "${f#*:}" || { echo "$work/killed/${f%%:*} is not a copy of ${f#*:}"; exit 1; }
 done
-echo "same table after 5 kills; nothing stored was recomputed; the inputs kept beside it"
+echo "same table after 5 kills; nothing stored was recomputed; the inputs kept beside it; --plan's replay said where the resume started"

@@ -10,6 +10,7 @@
 #   README (a session's end killed it once and the time lost is bounded, not known), against
 #   the plan's steps it ran: all but stage 1, whose cylinders it found in its store. The
 #   prediction must be within 30 % of both ends, so of whatever the run really took.
+#   And the plan's replay of that store finds every record use of simulations.csv, nothing left.
 #   usage: plan_vs_committed.sh GRANUCAL SOURCE_DIR
 set -euo pipefail
 bin=$1 src=$2
@@ -50,6 +51,14 @@ def judge(what, predicted, measured):
     ok = abs(off) <= 0.30
     fails += not ok
     print(f"{'ok  ' if ok else 'FAIL'} {what}: expected {predicted:.2f}, measured {measured:.2f} ({off:+.0%})")
+# The plan replays the store (running nothing): a finished run's store holds every record use its
+# simulations.csv lists, so nothing is left.
+with open(f"{run}/simulations.csv") as f:
+    uses = sum(1 for _ in csv.DictReader(f))
+left = re.search(r"^== left: nothing; .* \((\d+) found\)", plan, re.M)
+ok = left is not None and int(left.group(1)) == uses
+fails += not ok
+print(f"{'ok  ' if ok else 'FAIL'} the replay of the store: {left.group(0) if left else 'no left line'}; simulations.csv: {uses} uses")
 judge("core-hours, whole calibration", planned_core_h, measured_core_h)
 judge("wall hours on 2 workers, the steps it ran, against the time counted", planned_wall_h, counted_h)
 judge("wall hours on 2 workers, the steps it ran, against the most it took", planned_wall_h, at_most_h)

@@ -6,6 +6,8 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -71,11 +73,46 @@ static void without_fork_tasks_run_inline_and_nothing_is_granted(void **state)
     assert_int_equal(cal_pool_take_granted_cores(), 0);
 }
 
+// A probe (cal_pool_probe): what the child leaves in `result` comes back whole,
+// even past a pipe's buffer; what it does to its own memory does not; a child
+// that fails is reported.
+enum { PROBE_BYTES = 1 << 18 }; // 256 KiB: four times a Linux pipe's buffer
+
+typedef struct probe_state {
+    int touched; ///< set by the child: stays 0 here
+} probe_state;
+
+static int fill_result(void *ctx, void *result)
+{
+    ((probe_state *)ctx)->touched = 1;
+    unsigned char *bytes = result;
+    for (size_t i = 0; i < PROBE_BYTES; ++i) bytes[i] = (unsigned char)(i * 7 + 3);
+    fputs("a probe's output goes to /dev/null\n", stderr);
+    return 0;
+}
+
+static int fail_probe(void *ctx, void *result) { (void)ctx, (void)result; return 1; }
+
+static void a_probe_returns_its_result_and_keeps_its_side_effects(void **state)
+{
+    (void)state;
+    probe_state s = {0};
+    unsigned char *result = calloc(PROBE_BYTES, 1);
+    assert_non_null(result);
+    assert_int_equal(cal_pool_probe(fill_result, &s, result, PROBE_BYTES), 0);
+    for (size_t i = 0; i < PROBE_BYTES; ++i)
+        if (result[i] != (unsigned char)(i * 7 + 3)) fail_msg("byte %zu came back as %u", i, result[i]);
+    assert_int_equal(s.touched, 0);
+    assert_int_equal(cal_pool_probe(fail_probe, &s, result, PROBE_BYTES), 1);
+    free(result);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_last_running_task_gets_the_idle_core),
         cmocka_unit_test(without_fork_tasks_run_inline_and_nothing_is_granted),
+        cmocka_unit_test(a_probe_returns_its_result_and_keeps_its_side_effects),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
