@@ -138,8 +138,8 @@ static int parse_options(int argc, char **argv, options *o)
                         "one grid; a two-tier stage runs its max_evaluations; k_n is stage 1's choice where its "
                         "cylinders are already in OUT/store, else the config's. Worst case: max_time, every "
                         "evaluation, the stiffest k_n. Records already in OUT/store are not subtracted there; where "
-                        "OUT/store exists, a last line (== left) replays the stages on it, running and writing "
-                        "nothing, and says where a run would resume (the step, the records found, the runs of the "
+                        "OUT/store exists, a last line (== left; a run prints it too) replays the stages on it, running "
+                        "and writing nothing, and says where a run would resume (the step, the records found, the runs of the "
                         "next batch missing) and the expected cost left: each step's expected runs less those found. "
                         "tests/calibration/plan_vs_committed.sh holds the expected figures within 30 % of what the "
                         "committed standard run (results/calibration-standard/) took."),
@@ -796,7 +796,7 @@ static void print_left(const run *r, const plan *p, const replay_outcome *o)
             found, o->missing, left.runs, e, measured);
 }
 
-// --plan on a store that holds part of the calibration: where it would resume, and what is left.
+// The plan (and a run) on a store that holds part of the calibration: where it resumes, and what is left.
 static void plan_left(run *r, const plan *p)
 {
     char store[1100];
@@ -805,8 +805,7 @@ static void plan_left(run *r, const plan *p)
     replay_outcome *o = calloc(1, sizeof *o);
     if (!o) return;
     if (cal_pool_probe(replay_in_child, r, o, sizeof *o) == 0) print_left(r, p, o);
-    else fprintf(stderr, "== left: not known: replaying %s stopped on an error (a damaged record?); the run itself "
-                         "says which\n", store);
+    else fprintf(stderr, "== left: not known: replaying %s stopped on an error; a run says which\n", store);
     free(o);
 }
 
@@ -825,7 +824,7 @@ static int check_predicted_cost(run *r)
     if (failed) return free(p), 1;
     print_plan(r, p);
     for (int k = 0; k < p->n; ++k) cal_progress_expect(&r->progress, p->name[k], p->step[k].expected.runs);
-    if (r->opt.plan_only) plan_left(r, p);
+    plan_left(r, p); // a resumed run says where it resumes, as its plan does
     int parallel = r->env.workers * cal_mpi_size();
     double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);
     char e[128], w[128];

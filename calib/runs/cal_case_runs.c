@@ -820,11 +820,11 @@ static void run_missing_drum(drum_batch *b, const drum_run *missing, int n_missi
     free(level), free(turned);
 }
 
-// A record of the store: 0 found, 1 missing, -1 an error. Store-only, a damaged
-// record is an error, not moved aside: a plan changes nothing.
+// A record of the store: 0 found, 1 missing (or damaged: run again), -1 an error.
+// Store-only, a damaged record stays where it is: a plan changes nothing.
 static int look_up(const cal_env *env, const char *key, cal_record *out, char *err, size_t len)
 {
-    return env->store_only ? cal_store_get(env->store, key, out, err, len) : cal_store_lookup(env->store, key, out, err, len);
+    return env->store_only ? cal_store_peek(env->store, key, out, err, len) : cal_store_lookup(env->store, key, out, err, len);
 }
 
 // Store-only, a batch with n runs missing: the evaluation ends here (an error).

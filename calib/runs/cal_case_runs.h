@@ -31,7 +31,8 @@ typedef struct cal_env {
     /// Read the store, run nothing (a plan replaying a resumed run): the first
     /// batch with a record missing ends the evaluation with an error, and
     /// `store_missing` says how many of its runs were missing. Nothing is
-    /// written: not a failed record, and a damaged one is not moved aside.
+    /// written: not a failed record, and a damaged one (missing: it will run
+    /// again) is not moved aside.
     int store_only;
     int store_missing;
     int mapping;                        ///< the level running in a two-tier stage: 0 the tier's own, 1

@@ -118,6 +118,12 @@ int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, 
     return got == DAMAGED ? -1 : got;
 }
 
+int cal_store_peek(const char *dir, const char *key, cal_record *out, char *err, size_t len)
+{
+    int got = load_record(dir, key, out, err, len);
+    return got == DAMAGED ? 1 : got;
+}
+
 int cal_store_lookup(const char *dir, const char *key, cal_record *out, char *err, size_t len)
 {
     int got = load_record(dir, key, out, err, len);

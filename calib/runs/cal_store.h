@@ -45,6 +45,10 @@ void cal_store_path(const char *dir, const char *key, char *out, size_t len);
 /// A retry record written by another run counts as absent.
 int cal_store_get(const char *dir, const char *key, cal_record *out, char *err, size_t len);
 
+/// cal_store_get for a plan replaying a run: a damaged record counts as
+/// absent (1), the simulation the run will make again, and stays where it is.
+int cal_store_peek(const char *dir, const char *key, cal_record *out, char *err, size_t len);
+
 /// cal_store_get for a run that simulates what is missing: a damaged record
 /// (cut short, not YAML, a field missing) is moved to DIR/damaged/HASH.yaml
 /// (kept for inspection, never deleted; a later damaged copy replaces it),
