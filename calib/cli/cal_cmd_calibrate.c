@@ -127,7 +127,8 @@ static int parse_options(int argc, char **argv, options *o)
                                                             "(default 120; 0: none)"),
         cal_option_budget_hours(&o->budget_hours,
                                 "refuse, before the first simulation, a run whose EXPECTED wall time (the plan's, "
-                                "below) is over H hours; the worst case is printed beside it, not judged"),
+                                "below; of a resumed run, what is left of it) is over H hours; the worst case is "
+                                "printed beside it, not judged"),
         cal_option_plan(&o->plan_only,
                         "check every input, print the plan and stop: nothing runs, no folder is made. For each step "
                         "and in all: simulations, core-hours and wall hours on --jobs workers, EXPECTED and (in "
@@ -762,9 +763,21 @@ static int step_runs_left(const run *r, const plan *p, int k, const replay_outco
     return j == o->current && left < o->missing ? o->missing : left > 0 ? left : 0;
 }
 
-// Where the store ends and what is left: each step's runs left at the plan's
-// expected cost per run, and the time left at the stored runs' own costs.
-static void print_left(const run *r, const plan *p, const replay_outcome *o)
+// What is left of the plan's expected figure: each step's runs left at its expected cost per run.
+static cal_plan_cost cost_left(const run *r, const plan *p, const replay_outcome *o)
+{
+    cal_plan_cost left = {0};
+    for (int k = 0; k < p->n; ++k) {
+        int runs = step_runs_left(r, p, k, o);
+        const cal_plan_cost *e = p->step[k].expected.runs > 0 ? &p->step[k].expected : &p->step[k].worst;
+        if (runs == 0 || e->runs == 0) continue;
+        left.runs += runs, left.core_s += e->core_s * runs / e->runs, left.wall_s += e->wall_s * runs / e->runs;
+    }
+    return left;
+}
+
+// Where the store ends and what is left, at the plan's cost per run and at the stored runs' own costs.
+static void print_left(const run *r, const replay_outcome *o, const cal_plan_cost *left)
 {
     int found = 0;
     for (int k = 0; k < r->progress.n_stages; ++k) found += o->done[k];
@@ -773,15 +786,8 @@ static void print_left(const run *r, const plan *p, const replay_outcome *o)
                         "re-derives its outputs from it\n", r->out, found);
         return;
     }
-    cal_plan_cost left = {0};
-    for (int k = 0; k < p->n; ++k) {
-        int runs = step_runs_left(r, p, k, o);
-        const cal_plan_cost *e = p->step[k].expected.runs > 0 ? &p->step[k].expected : &p->step[k].worst;
-        if (runs == 0 || e->runs == 0) continue;
-        left.runs += runs, left.core_s += e->core_s * runs / e->runs, left.wall_s += e->wall_s * runs / e->runs;
-    }
     char e[128], measured[160] = "";
-    cal_plan_describe(&left, r->env.workers * cal_mpi_size(), e, sizeof e);
+    cal_plan_describe(left, r->env.workers * cal_mpi_size(), e, sizeof e);
     if (isfinite(o->eta_expected_s) && isfinite(o->eta_bound_s)) {
         char expected[32], bound[32];
         cal_progress_format_duration(o->eta_expected_s, expected, sizeof expected);
@@ -793,24 +799,28 @@ static void print_left(const run *r, const plan *p, const replay_outcome *o)
                     "those found, at the plan's cost per run)%s. What the search does from there, only running it "
                     "shows.\n",
             r->out, o->current + 1, r->progress.n_stages, o->current >= 0 ? r->progress.stage[o->current].name : "-",
-            found, o->missing, left.runs, e, measured);
+            found, o->missing, left->runs, e, measured);
 }
 
-// The plan (and a run) on a store that holds part of the calibration: where it resumes, and what is left.
-static void plan_left(run *r, const plan *p)
+// The plan (and a run) on a store that holds part of the calibration: where it
+// resumes, and what is left (*left; 1 if known, 0 with no store or no replay).
+static int plan_left(run *r, const plan *p, cal_plan_cost *left)
 {
     char store[1100];
     snprintf(store, sizeof store, "%s/store", r->out);
-    if (cal_mpi_size() > 1 || access(store, F_OK) != 0) return; // nothing stored (or ranks, which must not fork)
+    if (cal_mpi_size() > 1 || access(store, F_OK) != 0) return 0; // nothing stored (or ranks, which must not fork)
     replay_outcome *o = calloc(1, sizeof *o);
-    if (!o) return;
-    if (cal_pool_probe(replay_in_child, r, o, sizeof *o) == 0) print_left(r, p, o);
+    if (!o) return 0;
+    int known = cal_pool_probe(replay_in_child, r, o, sizeof *o) == 0;
+    if (known) *left = cost_left(r, p, o), print_left(r, o, left);
     else fprintf(stderr, "== left: not known: replaying %s stopped on an error; a run says which\n", store);
     free(o);
+    return known;
 }
 
 // The plan printed; refused if one simulation per worker cannot fit the
-// memory free, or if the EXPECTED wall time is over --budget-hours.
+// memory free, or if the EXPECTED wall time left (the whole plan's on a store
+// that holds none of it) is over --budget-hours.
 static int check_predicted_cost(run *r)
 {
     plan *p = calloc(1, sizeof *p);
@@ -824,12 +834,14 @@ static int check_predicted_cost(run *r)
     if (failed) return free(p), 1;
     print_plan(r, p);
     for (int k = 0; k < p->n; ++k) cal_progress_expect(&r->progress, p->name[k], p->step[k].expected.runs);
-    plan_left(r, p); // a resumed run says where it resumes, as its plan does
+    cal_plan_cost left;
+    int resumed = plan_left(r, p, &left); // a resumed run says where it resumes, as its plan does
     int parallel = r->env.workers * cal_mpi_size();
     double memory_mb = fmax(p->total.expected.memory_mb, p->total.worst.memory_mb);
     char e[128], w[128];
-    cal_plan_describe(&p->total.expected, parallel, e, sizeof e), cal_plan_describe(&p->total.worst, parallel, w, sizeof w);
-    double expected_h = p->total.expected.wall_s / 3600;
+    cal_plan_describe(resumed ? &left : &p->total.expected, parallel, e, sizeof e);
+    cal_plan_describe(&p->total.worst, parallel, w, sizeof w);
+    double expected_h = (resumed ? left.wall_s : p->total.expected.wall_s) / 3600;
     free(p);
     long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
     double free_mb = pages > 0 && page > 0 ? (double)pages * (double)page / 1048576 : INFINITY;
@@ -837,8 +849,9 @@ static int check_predicted_cost(run *r)
         return exp_fail(r->err, sizeof r->err, "tier '%s': %.0f MB a simulation; %d at once need more than the %.0f MB "
                         "free: use fewer --jobs or a coarser tier", r->t->name, memory_mb, r->env.workers, free_mb);
     if (expected_h > r->opt.budget_hours)
-        return exp_fail(r->err, sizeof r->err, "tier '%s': expected %s (worst case %s), over --budget-hours %g, which "
-                        "judges the expected figure: nothing was run", r->t->name, e, w, r->opt.budget_hours);
+        return exp_fail(r->err, sizeof r->err, "tier '%s': expected%s %s (the whole calibration's worst case %s), over "
+                        "--budget-hours %g, which judges the expected figure: nothing was run", r->t->name,
+                        resumed ? " left" : "", e, w, r->opt.budget_hours);
     return 0;
 }
 

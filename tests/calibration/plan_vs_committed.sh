@@ -10,7 +10,8 @@
 #   README (a session's end killed it once and the time lost is bounded, not known), against
 #   the plan's steps it ran: all but stage 1, whose cylinders it found in its store. The
 #   prediction must be within 30 % of both ends, so of whatever the run really took.
-#   And the plan's replay of that store finds every record use of simulations.csv, nothing left.
+#   And the plan's replay of that store finds every record use of simulations.csv, nothing left, so
+#   --budget-hours (which judges what is left) passes at any budget.
 #   usage: plan_vs_committed.sh GRANUCAL SOURCE_DIR
 set -euo pipefail
 bin=$1 src=$2
@@ -19,6 +20,10 @@ cd "$src"
 plan=$("$bin" calibrate "$run/config.yaml" --tier standard --jobs 2 --plan --out "$run" --data "$run" 2>&1 >/dev/null) ||
   { echo "$plan"; exit 1; }
 echo "$plan"
+# --budget-hours judges what is left: nothing of a finished run, so the least budget passes.
+"$bin" calibrate "$run/config.yaml" --tier standard --jobs 2 --plan --out "$run" --data "$run" --budget-hours 0.001 \
+  > /dev/null 2>&1 || { echo "FAIL: --budget-hours refused a finished run's folder, where nothing is left"; exit 1; }
+echo "ok   --budget-hours 0.001 on the finished run's folder: nothing left, not refused"
 PLAN=$plan python3 - "$run" <<'PY'
 import csv, os, re, sys
 run = sys.argv[1]
