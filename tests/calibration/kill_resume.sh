@@ -44,10 +44,10 @@ done
 before=$(records)
 # --plan replays the killed store (running nothing, writing nothing) and says where the run resumes.
 left() { "$bin" "${args[@]}" --out "$work/killed" --plan 2>&1 | grep '^== left:' || echo "(no left line)"; }
-store_sums() { (cd "$work/killed/store" && find . -type f | sort | xargs md5sum); }
-sums=$(store_sums)
+folder_sums() { (cd "$work/killed" && find . -type f | sort | xargs md5sum); } # the store, stage files, inputs
+sums=$(folder_sums)
 left_killed=$(left)
-[ "$(store_sums)" = "$sums" ] || { echo "--plan changed the store"; exit 1; }
+[ "$(folder_sums)" = "$sums" ] || { echo "--plan changed the killed run's folder"; exit 1; }
 echo "plan on the killed store: $left_killed"
 stamp=$(mktemp)
 "$bin" "${args[@]}" --out "$work/killed" > "$work/resume.log" 2>&1 || { cat "$work/resume.log"; exit 1; }
