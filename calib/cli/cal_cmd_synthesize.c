@@ -139,7 +139,8 @@ static int parse_options(int argc, char **argv, options *o)
         cal_option_jobs(&o->jobs),
         cal_option_plan(&o->plan_only, "check every input, print the plan (drum runs, core-hours and wall hours on "
                                        "--jobs workers, expected and worst case) and stop: nothing runs, no folder "
-                                       "is made"),
+                                       "is made. Where OUT/store (or --reuse) holds some of the runs, a last line "
+                                       "(== left) counts them and says what is left"),
     };
     const cal_command_line line = {.command = "synthesize", .synopsis = synopsis, .epilogue = epilogue, .options = table,
                                    .n_options = sizeof table / sizeof *table};
@@ -366,9 +367,49 @@ static int write_files(job *j, const lining_result *res, const char *command)
     return write_series(j, res, command, 1) || write_series(j, res, command, 0);
 }
 
+// How many of lining l's runs (its seeds x speeds) a store already holds: a
+// synthesis runs a fixed set, so its keys say what is left (read only).
+static int runs_stored(const job *j, const lining *l, const char *store)
+{
+    int n = 0;
+    for (int s = 0; s < j->opt.n_seeds && store; ++s) {
+        cal_drum_case d = case_of(j, l, j->opt.seeds[s]);
+        for (int k = 0; k < j->n_rpm; ++k) {
+            char key[2048], err[512];
+            cal_record r;
+            cal_drum_key(&d, j->rpm[k], key, sizeof key);
+            if (cal_store_peek(store, key, &r, err, sizeof err) == 0) cal_record_free(&r), ++n;
+        }
+    }
+    return n;
+}
+
+// What is left where OUT/store (or --reuse) holds runs already: each lining's
+// runs not stored, at its expected cost per run.
+static void print_left(const job *j, const cal_plan *lining_cost, const char *store)
+{
+    cal_plan_cost left = {0};
+    int stored = 0, all = 0;
+    for (int l = 0; l < j->n_linings; ++l) {
+        int here = runs_stored(j, &j->linings[l], store), reused = runs_stored(j, &j->linings[l], j->opt.reuse);
+        int have = here > reused ? here : reused, runs = j->opt.n_seeds * j->n_rpm;
+        const cal_plan_cost *e = &lining_cost[l].expected;
+        stored += have, all += runs;
+        if (have < runs && e->runs > 0)
+            left.runs += runs - have, left.core_s += e->core_s * (runs - have) / e->runs,
+                left.wall_s += e->wall_s * (runs - have) / e->runs;
+    }
+    if (stored == 0) return;
+    char e[128];
+    cal_plan_describe(&left, j->opt.jobs * cal_mpi_size(), e, sizeof e);
+    fprintf(stderr, "== left: %d of %d drum runs already in %s%s%s; expected left: %d drum runs, %s (each lining's "
+                    "expected cost per run)\n", stored, all, store, j->opt.reuse ? " or " : "",
+            j->opt.reuse ? j->opt.reuse : "", left.runs, e);
+}
+
 // What making the data costs: each lining's seeds side by side, each seed
-// settling its own bed and turning the speeds (cal_plan.h; records already in
-// the store or --reuse are not subtracted).
+// settling its own bed and turning the speeds (cal_plan.h); then what is
+// left of it where a store holds some.
 static void print_plan(const job *j)
 {
     int parallel = j->opt.jobs * cal_mpi_size();
@@ -379,6 +420,7 @@ static void print_plan(const job *j)
     cal_plan_history history; // unreadable: the plan takes max_time for MSER runs, and says how many
     snprintf(store, sizeof store, "%s/store", j->out);
     cal_plan_history_read(&history, store, err, sizeof err);
+    cal_plan lining_cost[MAX_WALLS + 1];
     for (int l = 0; l < j->n_linings; ++l) {
         cal_plan p = {{0}, {0}};
         cal_drum_case d = case_of(j, &j->linings[l], j->opt.seeds[0]);
@@ -393,16 +435,19 @@ static void print_plan(const job *j)
                 p.expected.runs, p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600,
                 p.worst.wall_s / 3600);
         cal_plan_add(&total, &p);
+        lining_cost[l] = p;
     }
     char e[128], w[128], mser[1300];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     cal_plan_describe_mser(&total.expected, store, mser, sizeof mser);
     fprintf(stderr, "== plan: %d drum runs (%d lining(s) x %d seed(s) x %d speed(s)); expected %s; worst case %s; %.0f MB a "
                     "simulation\n   " CAL_PLAN_RUN_ASSUMPTION " (%s.) k_n %g N/m. At %.2g particle-steps per core-second "
-                    "(this project's 2-core machine); records already in the store or --reuse are not subtracted.\n",
+                    "(this project's 2-core machine): the whole synthesis; where a store holds some of it, a last line says what "
+                    "is left.\n",
             total.expected.runs, j->n_linings, j->opt.n_seeds, j->n_rpm, e, w, total.expected.memory_mb, mser, j->k_n,
             CAL_PLAN_RATE);
     cal_plan_history_free(&history);
+    print_left(j, lining_cost, store);
 }
 
 static int prepare(job *j)

@@ -15,6 +15,12 @@ fail() { echo "FAIL: $*"; exit 1; }
 # A synthesize that stops: its exit code and the end of its log (gone with the work folder).
 synthesize() { local log=$1 rc=0; shift; "$bin" synthesize "$@" 2> "$log" || rc=$?; [ $rc -eq 0 ] || fail "synthesize stopped (exit $rc): $(tail -20 "$log")"; }
 synthesize "$work/made.log" "${args[@]}" --out "$work/made"
+# Before the second synthesize, its plan counts what --reuse holds: every run, nothing left.
+total=$((4 * 2)) # 4 linings x 1 seed x the quick tier's 2 speeds
+left=$("$bin" synthesize "${args[@]}" --out "$work/reused" --reuse "$work/made/store" --plan 2>&1 | grep '^== left:') ||
+  fail "the plan says nothing of the runs --reuse holds"
+echo "$left" | grep -q "^== left: $total of $total drum runs already in .*; expected left: 0 drum runs" ||
+  fail "the plan should find all $total runs in --reuse: $left"
 synthesize "$work/reused.log" "${args[@]}" --out "$work/reused" --reuse "$work/made/store"
 made_runs=$(ls "$work/made/store" | wc -l)
 [ "$made_runs" -ge 2 ] || fail "the first synthesize stored $made_runs runs"
