@@ -367,18 +367,26 @@ static int write_files(job *j, const lining_result *res, const char *command)
     return write_series(j, res, command, 1) || write_series(j, res, command, 0);
 }
 
-// How many of lining l's runs (its seeds x speeds) a store already holds: a
-// synthesis runs a fixed set, so its keys say what is left (read only).
+// 1 if a store holds the record of key (read only; NULL: no store).
+static int stored_in(const char *store, const char *key)
+{
+    char err[512];
+    cal_record r;
+    if (!store || cal_store_peek(store, key, &r, err, sizeof err) != 0) return 0;
+    return cal_record_free(&r), 1;
+}
+
+// How many of lining l's runs (its seeds x speeds) OUT/store or --reuse
+// already holds: a synthesis runs a fixed set, so its keys say what is left.
 static int runs_stored(const job *j, const lining *l, const char *store)
 {
     int n = 0;
-    for (int s = 0; s < j->opt.n_seeds && store; ++s) {
+    for (int s = 0; s < j->opt.n_seeds; ++s) {
         cal_drum_case d = case_of(j, l, j->opt.seeds[s]);
         for (int k = 0; k < j->n_rpm; ++k) {
-            char key[2048], err[512];
-            cal_record r;
+            char key[2048];
             cal_drum_key(&d, j->rpm[k], key, sizeof key);
-            if (cal_store_peek(store, key, &r, err, sizeof err) == 0) cal_record_free(&r), ++n;
+            n += stored_in(store, key) || stored_in(j->opt.reuse, key);
         }
     }
     return n;
@@ -391,8 +399,7 @@ static void print_left(const job *j, const cal_plan *lining_cost, const char *st
     cal_plan_cost left = {0};
     int stored = 0, all = 0;
     for (int l = 0; l < j->n_linings; ++l) {
-        int here = runs_stored(j, &j->linings[l], store), reused = runs_stored(j, &j->linings[l], j->opt.reuse);
-        int have = here > reused ? here : reused, runs = j->opt.n_seeds * j->n_rpm;
+        int have = runs_stored(j, &j->linings[l], store), runs = j->opt.n_seeds * j->n_rpm;
         const cal_plan_cost *e = &lining_cost[l].expected;
         stored += have, all += runs;
         if (have < runs && e->runs > 0)
