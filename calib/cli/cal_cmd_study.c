@@ -110,8 +110,10 @@ static int parse_options(int argc, char **argv, options *o)
         cal_option_checkpoint_every(&o->checkpoint_every_s, "wall seconds between a drum run's checkpoints (default "
                                                             "120; 0: none); a killed study, run again, resumes each turn"),
         cal_option_plan(&o->plan_only, "check the config, print the plan (each rung's drum runs, core-hours and wall "
-                                       "hours on --jobs workers, expected and worst case, and which fit the budget) "
-                                       "and stop: nothing runs"),
+                                       "hours on --jobs workers, expected and worst case, which fit the budget, and "
+                                       "how many of its runs OUT/store holds; a rung held whole runs whatever the "
+                                       "budget) and stop: nothing runs. Where it holds some, a last line (== left) says "
+                                       "what is left"),
         {.name = "yes", .kind = CAL_OPT_FLAG, .flag = &o->yes, .set_to = 1,
          .help = "run every rung: without --rungs the study prints its plan and stops with exit status 2 (the whole "
                  "ladder is many hours)"},
@@ -182,20 +184,26 @@ static cal_drum_case case_of(const study *s, const cal_tier *r, int seed)
 }
 
 // 1 if every simulation of the rung is already in the store.
-static int all_stored(const study *s, const cal_tier *r)
+// How many of rung r's runs (its seeds x speeds) the store already holds (a file of their key).
+static int runs_stored(const study *s, const cal_tier *r, const char *store)
 {
     const cal_fidelity *f = s->c->fidelity;
+    int n = 0;
     for (int seed = 0; seed < f->seeds; ++seed) {
         cal_drum_case d = case_of(s, r, seed);
         for (unsigned k = 0; k < f->rpm_count; ++k) {
             char key[2048], path[1300];
             cal_drum_key(&d, f->rpm[k], key, sizeof key);
-            cal_store_path(s->env.store, key, path, sizeof path);
-            if (access(path, F_OK) != 0) return 0;
+            cal_store_path(store, key, path, sizeof path);
+            n += access(path, F_OK) == 0;
         }
     }
-    return 1;
+    return n;
 }
+
+static int runs_of(const study *s) { return s->c->fidelity->seeds * (int)s->c->fidelity->rpm_count; }
+
+static int all_stored(const study *s, const cal_tier *r) { return runs_stored(s, r, s->env.store) == runs_of(s); }
 
 // Wall time of a rung scaled from a measured one: granules ~ depth/lambda
 // (same bed volume per depth, granule volume ~ lambda), steps per simulated
@@ -230,6 +238,8 @@ static double print_plan(const study *s)
     int parallel = s->opt.jobs * cal_mpi_size();
     double budget_s = 3600 * (isfinite(s->opt.budget_hours) ? s->opt.budget_hours : f->budget_hours), spent = 0;
     cal_plan total = {{0}, {0}};
+    cal_plan_cost left = {0}; // of the rungs that fit: their runs not stored, at the rung's expected cost per run
+    int any_stored = 0;
     char store[1100], err[1024];
     cal_plan_history history; // unreadable: the plan takes max_time for MSER runs, and says how many
     snprintf(store, sizeof store, "%s/store", s->opt.out);
@@ -244,20 +254,37 @@ static double print_plan(const study *s)
         for (int w = 0; w < 2; ++w)
             cal_plan_drum_batch(w ? &p.worst : &p.expected, &d, f->rpm, (int)f->rpm_count, f->seeds, 1, 0, 0, parallel, w,
                                 &history);
-        int fits = spent + p.expected.wall_s <= budget_s;
+        // A rung whose runs are all stored runs whatever the budget, as run_ladder does.
+        int stored = runs_stored(s, rung, store), all = runs_of(s);
+        int fits = stored == all || spent + p.expected.wall_s <= budget_s;
         spent += fits ? p.expected.wall_s : 0;
-        fprintf(stderr, "   %-22s %4d drum runs %8.2f (%8.2f) core-hours %7.2f (%7.2f) h%s\n", rung->name, p.expected.runs,
+        char note[64] = "";
+        if (stored > 0) snprintf(note, sizeof note, "  %d of %d stored", stored, all);
+        fprintf(stderr, "   %-22s %4d drum runs %8.2f (%8.2f) core-hours %7.2f (%7.2f) h%s%s\n", rung->name, p.expected.runs,
                 p.expected.core_s / 3600, p.worst.core_s / 3600, p.expected.wall_s / 3600, p.worst.wall_s / 3600,
-                fits ? "" : "  over the budget left: not run");
-        if (fits) cal_plan_add(&total, &p);
+                fits ? "" : "  over the budget left: not run", note);
+        if (fits) {
+            cal_plan_add(&total, &p);
+            if (p.expected.runs > 0)
+                left.runs += all - stored, left.core_s += p.expected.core_s * (all - stored) / all,
+                    left.wall_s += p.expected.wall_s * (all - stored) / all;
+            any_stored |= stored > 0;
+        }
     }
     char e[128], w[128], mser[1300];
     cal_plan_describe(&total.expected, parallel, e, sizeof e), cal_plan_describe(&total.worst, parallel, w, sizeof w);
     cal_plan_describe_mser(&total.expected, store, mser, sizeof mser);
     fprintf(stderr, "== plan: the rungs within the budget (%.3g h): %d drum runs, expected %s; worst case %s\n"
                     "   " CAL_PLAN_RUN_ASSUMPTION " (%s.) At %.2g particle-steps per core-second (this project's 2-core "
-                    "machine); records already in the store are not subtracted.\n",
+                    "machine): the whole of those rungs; where the store holds some of their runs, a last line says "
+                    "what is left.\n",
             budget_s / 3600, total.expected.runs, e, w, mser, CAL_PLAN_RATE);
+    if (any_stored) {
+        char l[128];
+        cal_plan_describe(&left, parallel, l, sizeof l);
+        fprintf(stderr, "== left: %d of the %d drum runs not in %s yet; expected %s (each rung's expected cost per "
+                        "run)\n", left.runs, total.expected.runs, store, l);
+    }
     cal_plan_history_free(&history);
     return total.expected.wall_s;
 }

@@ -2,7 +2,7 @@
 # `granucal study fidelity` end to end on a tiny ladder: two cheap rungs run, a Table B.1
 # rung (lambda 8, full drum) is over the budget and listed with a predicted cost instead;
 # the finest rung run has error 0 (errors are against it), the other a finite one; a rerun
-# recomputes nothing. Then the committed ladder (results/fidelity_ladder/store) is read back at 4 rpm
+# recomputes nothing, and its plan says every run is stored. Then the committed ladder (results/fidelity_ladder/store) is read back at 4 rpm
 # and must be called still moving between lambda 1000 and 512.
 #   usage: study_fidelity.sh GRANUCAL SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -43,6 +43,12 @@ awk -v p="$(field L8-full predicted_wall_time_s)" 'BEGIN{exit !(p > 3600 && p < 
 for f in fidelity.csv fidelity.md fidelity_error_vs_cost.png fidelity_vs_lambda.png; do
   [ -s "$work/out/$f" ] || { echo "missing $f"; exit 1; }
 done
+# Its plan now counts the stored runs: the two rungs that ran hold their one run each, nothing is left.
+plan=$("$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 --plan 2>&1) || { echo "$plan"; exit 1; }
+for rung in coarse coarse-long; do
+  grep -q "^   $rung .*  1 of 1 stored$" <<< "$plan" || { echo "the plan does not count $rung's stored run: $plan"; exit 1; }
+done
+grep -q "^== left: 0 of the 2 drum runs not in $work/out/store yet" <<< "$plan" || { echo "the plan's left line: $plan"; exit 1; }
 # A rerun reads every simulation back from the store.
 "$bin" study fidelity "$cfg" --out "$work/out" --jobs 2 --yes > "$work/run2.log" 2>&1 || { cat "$work/run2.log"; exit 1; }
 if grep -q "simulated in" "$work/run2.log"; then echo "the rerun simulated again"; cat "$work/run2.log"; exit 1; fi
