@@ -574,13 +574,34 @@ static void turned_bed_path(const cal_env *env, const char *hash, char *out, siz
 // pour's cost) and takes the turn from the file. NULL with a message if it
 // failed. *fill_s: the pour's wall time; res->wall_time_s the turn's, with
 // what came before its file (res->earlier_wall_s).
-static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, double rpm, double *fill_s,
+// The turned bed's file read into an empty drum, or NULL (none, or one that
+// cannot be read: the bed is then poured). The turn that follows reads the
+// file again and goes on from it: a bed poured only to be overwritten by the
+// file cost a pour (~4 min of one core at lambda 1000) each time a resumed
+// calibration took a bed an earlier process had made.
+static dem_world *turned_bed_from_file(const cal_drum_case *c, const char *path, const char *key)
+{
+    char err[512];
+    if (access(path, F_OK) != 0) return NULL;
+    dem_world *w = exp_drum_create_empty(&c->start, err, sizeof err);
+    if (w && dem_checkpoint_read(w, path, key, NULL, 0, err, sizeof err) == 0) return w;
+    dem_world_destroy(w);
+    return NULL;
+}
+
+// from_file: a file an earlier process made may stand in for the pour (its
+// cost was charged there). A file a worker of this process made is read after
+// a pour as before: the pour is then charged here, in place of the worker's,
+// which the file does not hold.
+static dem_world *make_turned_bed(const cal_env *env, const cal_drum_case *c, double rpm, int from_file, double *fill_s,
                                   exp_drum_result *res, char *err, size_t len)
 {
     char key[2048], hash[17], path[1300], what[64], prefix[80];
     turned_bed_hash(c, rpm, key, sizeof key, hash);
     turned_bed_path(env, hash, path, sizeof path);
-    dem_world *bed = pour_bed(env, &c->start, fill_s, err, len);
+    *fill_s = 0;
+    dem_world *bed = from_file ? turned_bed_from_file(c, path, key) : NULL;
+    if (!bed) bed = pour_bed(env, &c->start, fill_s, err, len);
     if (!bed) return NULL;
     snprintf(what, sizeof what, "the turned bed of seed %llu, %g rpm", (unsigned long long)c->start.seed, rpm);
     snprintf(prefix, sizeof prefix, "[%s]", env->stage);
@@ -651,7 +672,7 @@ static int prepare_turned(int i, void *ctx)
     double fill_s;
     exp_drum_result res;
     char err[1024];
-    dem_world *bed = make_turned_bed(b->env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
+    dem_world *bed = make_turned_bed(b->env, &b->cases[r.c], b->rpm[r.k], 0, &fill_s, &res, err, sizeof err);
     if (!bed) return fprintf(stderr, "[%s] %s\n", b->env->stage, err), 1;
     dem_world_destroy(bed);
     return 0;
@@ -722,10 +743,11 @@ static dem_world *turned_bed_of(drum_batch *b, drum_run r, double *charge)
         // pool, a child inherits the pool but not its threads, and its first smaller region waits for
         // them to be released (the standard rerun's worker sat 20 min in a futex at 0 CPU, 2026-11-28,
         // acc31a7, reverted). A bed wanting more threads is made in a forked worker (prepare_turned).
-        dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], &fill_s, &res, err, sizeof err);
+        const int made_now = listed_hash(b->prepped, b->n_prep, hash); // by a worker of this batch
+        dem_world *bed = make_turned_bed(env, &b->cases[r.c], b->rpm[r.k], !made_now, &fill_s, &res, err, sizeof err);
         if (!bed) return write_failed(env, run_key(b, r), err), NULL;
         // A file made by an earlier process was charged there; one made now by a worker, here.
-        double turn_s = res.wall_time_s - (listed_hash(b->prepped, b->n_prep, hash) ? 0 : res.earlier_wall_s);
+        double turn_s = res.wall_time_s - (made_now ? 0 : res.earlier_wall_s);
         t = keep_turned(env, bed, hash, fill_s + turn_s);
         if (!t) return dem_world_destroy(bed), write_failed(env, run_key(b, r), "out of memory keeping the turned bed"), NULL;
     }

@@ -85,7 +85,7 @@ int exp_drum_check(const exp_drum_def *d, char *msg, size_t len)
     return 0;
 }
 
-static dem_world *create_drum(const exp_drum_def *d, char *err, size_t len)
+dem_world *exp_drum_create_empty(const exp_drum_def *d, char *err, size_t len)
 {
     double r = 0.5 * d->diameter;
     dem_world_def def = dem_default_world_def();
@@ -234,8 +234,8 @@ dem_world *exp_drum_fill(const exp_drum_def *d, exp_progress_fn progress, void *
     size_t cap = 3 * dem_gsd_count_for_volume(&gsd, 0.6 * bed_volume) + 16;
     double *diam = malloc(cap * sizeof *diam);
     if (!diam) return fill_failed(NULL, diam, err, len, "out of memory");
-    dem_world *w = create_drum(d, err, len);
-    if (!w) return free(diam), NULL; // create_drum wrote the message
+    dem_world *w = exp_drum_create_empty(d, err, len);
+    if (!w) return free(diam), NULL; // it wrote the message
     if (dem_gsd_sample(&gsd, d->seed, cap, diam)) return fill_failed(w, diam, err, len, "cannot sample sizes");
     double pitch = 1.05 * dem_gsd_max_diameter(&gsd), target = 100.0 * d->fill;
     for (size_t next = 0, layer = 0; csa_below(w, d, r) < target; ++layer) {
@@ -288,7 +288,7 @@ exp_drum_run_opts exp_default_drum_run_opts(void)
 
 dem_status exp_drum_tilt(dem_world *w, double degrees)
 {
-    // The drum's axis is z through the origin (create_drum); a positive spin
+    // The drum's axis is z through the origin (exp_drum_create_empty); a positive spin
     // about +z turns it counter-clockwise seen from +z, as this does.
     return dem_world_rotate(w, dem_v3(0, 0, 0), dem_v3(0, 0, 1), degrees * DEM_PI / 180.0);
 }

@@ -86,6 +86,12 @@ double exp_drum_fill_level(double r, double fill);
 int exp_drum_check(const exp_drum_def *d, char *msg, size_t len);
 
 
+/// The drum of d with no granules: its domain, contact law and walls. A
+/// world to read a checkpoint of this drum into (dem_checkpoint_read
+/// replaces its whole state), without pouring a bed only to overwrite it.
+/// NULL with a message.
+dem_world *exp_drum_create_empty(const exp_drum_def *d, char *err, size_t len);
+
 /// Build the drum and fill it as the lab does, by bed volume: granules are
 /// poured in layers into the empty upper part of the drum, each layer
 /// landing before the next is placed, until the bed's occupied CSA (eq. 20)
