@@ -768,10 +768,8 @@ static cal_plan_cost cost_left(const run *r, const plan *p, const replay_outcome
 {
     cal_plan_cost left = {0};
     for (int k = 0; k < p->n; ++k) {
-        int runs = step_runs_left(r, p, k, o);
         const cal_plan_cost *e = p->step[k].expected.runs > 0 ? &p->step[k].expected : &p->step[k].worst;
-        if (runs == 0 || e->runs == 0) continue;
-        left.runs += runs, left.core_s += e->core_s * runs / e->runs, left.wall_s += e->wall_s * runs / e->runs;
+        cal_plan_add_runs(&left, e, step_runs_left(r, p, k, o));
     }
     return left;
 }

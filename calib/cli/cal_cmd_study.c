@@ -265,9 +265,7 @@ static double print_plan(const study *s)
                 fits ? "" : "  over the budget left: not run", note);
         if (fits) {
             cal_plan_add(&total, &p);
-            if (p.expected.runs > 0)
-                left.runs += all - stored, left.core_s += p.expected.core_s * (all - stored) / all,
-                    left.wall_s += p.expected.wall_s * (all - stored) / all;
+            cal_plan_add_runs(&left, &p.expected, all - stored);
             any_stored |= stored > 0;
         }
     }

@@ -400,11 +400,8 @@ static void print_left(const job *j, const cal_plan *lining_cost, const char *st
     int stored = 0, all = 0;
     for (int l = 0; l < j->n_linings; ++l) {
         int have = runs_stored(j, &j->linings[l], store), runs = j->opt.n_seeds * j->n_rpm;
-        const cal_plan_cost *e = &lining_cost[l].expected;
         stored += have, all += runs;
-        if (have < runs && e->runs > 0)
-            left.runs += runs - have, left.core_s += e->core_s * (runs - have) / e->runs,
-                left.wall_s += e->wall_s * (runs - have) / e->runs;
+        cal_plan_add_runs(&left, &lining_cost[l].expected, runs - have);
     }
     if (stored == 0) return;
     char e[128];

@@ -148,3 +148,10 @@ void cal_plan_add(cal_plan *total, const cal_plan *p)
 {
     add_cost(&total->expected, &p->expected), add_cost(&total->worst, &p->worst);
 }
+
+void cal_plan_add_runs(cal_plan_cost *total, const cal_plan_cost *c, int runs)
+{
+    if (runs <= 0 || c->runs <= 0) return;
+    total->runs += runs;
+    total->core_s += c->core_s * runs / c->runs, total->wall_s += c->wall_s * runs / c->runs;
+}

@@ -69,6 +69,10 @@ typedef struct cal_plan {
 /// largest memory).
 void cal_plan_add(cal_plan *total, const cal_plan *p);
 
+/// Add `runs` of c's runs to a total at c's cost per run: what is left of a
+/// step whose other runs a store holds. Nothing if runs or c's runs are 0.
+void cal_plan_add_runs(cal_plan_cost *total, const cal_plan_cost *c, int runs);
+
 /// Simulated seconds a drum run of case d turns at rpm: the worst case
 /// max_time; expected, the steady test's first chance (its two windows, then
 /// the averaging time), at most max_time. Every λ 1000 run of the committed
