@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# The lab book's runs in progress: one home for their commands, so that a session resumes them as the
+# last one left them, says where they stand, and commits their stores before it stops.
+#
+#   bash results/long_runs.sh status          each run: running or not, records stored, its log's last line
+#   bash results/long_runs.sh start [NAME...] resume those not running (by default those the table marks
+#                                             yes), niced, in the background, each with a '=== resumed
+#                                             ...' line in its log
+#   bash results/long_runs.sh stop [NAME...]  SIGTERM (a drum run resumes from its last checkpoint, at most
+#                                             --checkpoint-every = 120 s of wall behind), and wait for the end
+#   bash results/long_runs.sh commit          commit the runs' folders (only those paths), if they changed
+#   bash results/long_runs.sh keep-committed [MINUTES]
+#                                             commit every MINUTES (default 20) until killed: a session's stop
+#                                             then loses at most that much of a finished simulation
+#
+# A run's records are named by a hash of all that defines them, so resuming with a newer granucal serves
+# its records only where its results version and keys are unchanged: `granucal ... --plan` on the run's
+# folder says how many it finds before anything starts (run it after a change to the engine or a tier).
+# Each run is one worker, one thread (OMP_NUM_THREADS=1, --jobs 1): on this 2-core machine two runs side
+# by side use it fully, where a lone run on two threads turns only 1.29-1.47x faster
+# (results/benchmarks/threads_2core/). NICE: a run's share when a test suite or a third run competes.
+# A run is listed here while its README says IN PROGRESS; take it out when it is done.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+granucal=${GRANUCAL:-build/granucal}
+
+# name | folder committed | log | nice | started by a plain `start` (yes) or only by name (waits: no core
+# for it while the others run) | command (from the repository root)
+runs=(
+  "rerun|results/calibration-standard-r2|results/calibration-standard-r2/run.log|10|yes|$granucal calibrate configs/calibration.yaml --tier standard --jobs 1 --out results/calibration-standard-r2"
+  "twin-data|results/twin_standard|results/twin_standard/data/run.log|10|yes|$granucal synthesize configs/calibration.yaml --tier standard --seeds 101,102,103 --granule 0.8,0.2 --k-n 200 --wall aluminium=0.8,0.2 --wall PP=0.9,0.0001 --wall PTFE=0.9,0.0001 --out results/twin_standard/data --jobs 1"
+  "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
+)
+field() { cut -d'|' -f"$2" <<< "$1"; }
+selected() { # selected ROW NAME...: the row is among the names given (when none: every row, or with
+  local row=$1 default=$2; shift 2 # DEFAULT yes, those a plain start starts)
+  [ $# -eq 0 ] && { [ "$default" = all ] || [ "$(field "$row" 5)" = yes ]; return; }
+  local n; for n in "$@"; do [ "$(field "$row" 1)" = "$n" ] && return 0; done
+  return 1
+}
+known() { local n r; for n in "$@"; do for r in "${runs[@]}"; do [ "$(field "$r" 1)" = "$n" ] && continue 2; done
+  echo "long_runs.sh: no run named '$n' (runs: $(for r in "${runs[@]}"; do printf '%s ' "$(field "$r" 1)"; done))" >&2; exit 2; done; }
+# The pid of a run's command (its parent process, the lowest pid: workers are its forked children, with
+# the same command line), empty if none runs; whatever path the binary was started by.
+pid_of() {
+  local args; args=$(field "$1" 6 | cut -d' ' -f2- | sed 's/[][\\.*^$+?(){}|]/\\&/g')
+  pgrep -f -- "(^|/)granucal $args\$" | head -1 || true
+}
+records() { find "$(field "$1" 2)" -path '*/store/*.yaml' 2>/dev/null | wc -l; }
+
+status() {
+  local r pid
+  for r in "${runs[@]}"; do
+    pid=$(pid_of "$r")
+    printf '%-15s %-9s %4d records  %s\n' "$(field "$r" 1)" "${pid:+running}" "$(records "$r")" "$(field "$r" 2)"
+    printf '                %s\n' "$(tail -1 "$(field "$r" 3)" 2>/dev/null | cut -c1-150)"
+  done
+}
+
+start() {
+  [ -x "$granucal" ] || { echo "long_runs.sh: $granucal not built (bash .ci/setup)" >&2; exit 1; }
+  local r log when commit
+  commit=$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- engine experiments calib || echo "+uncommitted")
+  for r in "${runs[@]}"; do
+    selected "$r" yes "$@" || continue
+    [ -z "$(pid_of "$r")" ] || { echo "$(field "$r" 1): already running"; continue; }
+    log=$(field "$r" 3) when=$(date -u +%Y-%m-%dT%H:%M:%SZ)
+    echo "=== resumed $when by $commit (results/long_runs.sh, nice $(field "$r" 4), one worker) ===" >> "$log"
+    # shellcheck disable=SC2086 # the command is words
+    OMP_NUM_THREADS=1 nohup nice -n "$(field "$r" 4)" $(field "$r" 6) >> "$log" 2>&1 < /dev/null &
+    echo "$(field "$r" 1): started (pid $!), log $log"
+  done
+}
+
+stop() {
+  local r pid pids=()
+  for r in "${runs[@]}"; do
+    selected "$r" all "$@" || continue
+    pid=$(pid_of "$r")
+    [ -n "$pid" ] || continue
+    echo "=== stopped $(date -u +%Y-%m-%dT%H:%M:%SZ) (SIGTERM, results/long_runs.sh) ===" >> "$(field "$r" 3)"
+    kill -TERM "$pid" && pids+=("$pid") && echo "$(field "$r" 1): SIGTERM sent (pid $pid)"
+  done
+  local p; for p in "${pids[@]}"; do while kill -0 "$p" 2>/dev/null; do sleep 1; done; done
+}
+
+commit() {
+  local r paths=() summary=()
+  for r in "${runs[@]}"; do paths+=("$(field "$r" 2)"); summary+=("$(field "$r" 1) $(records "$r")"); done
+  git add -A -- "${paths[@]}"
+  if git diff --cached --quiet -- "${paths[@]}"; then echo "long_runs.sh: nothing new to commit"; return 0; fi
+  local IFS=','
+  git commit -q -m "Long runs in progress (not results): records stored: ${summary[*]}" -- "${paths[@]}"
+  git log --oneline -1
+}
+
+keep_committed() {
+  local minutes=${1:-20}
+  [[ "$minutes" =~ ^[0-9]+$ ]] && [ "$minutes" -gt 0 ] || { echo "long_runs.sh: MINUTES must be a positive integer" >&2; exit 2; }
+  while sleep $((minutes * 60)); do
+    # another git command holding the index: try again shortly instead of failing the loop
+    local try; for try in 1 2 3 4 5 6; do [ -e .git/index.lock ] && sleep 10 || break; done
+    commit || true
+  done
+}
+
+cmd=${1:-status}; shift || true
+case $cmd in
+  status) status ;;
+  start) known "$@"; start "$@" ;;
+  stop) known "$@"; stop "$@" ;;
+  commit) commit ;;
+  keep-committed) keep_committed "$@" ;;
+  -h | --help | help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//' ;;
+  *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, commit, keep-committed; --help)" >&2; exit 2 ;;
+esac
