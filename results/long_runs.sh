@@ -89,8 +89,8 @@ commit() {
   for r in "${runs[@]}"; do paths+=("$(field "$r" 2)"); summary+=("$(field "$r" 1) $(records "$r")"); done
   git add -A -- "${paths[@]}"
   if git diff --cached --quiet -- "${paths[@]}"; then echo "long_runs.sh: nothing new to commit"; return 0; fi
-  local IFS=','
-  git commit -q -m "Long runs in progress (not results): records stored: ${summary[*]}" -- "${paths[@]}"
+  local joined; joined=$(printf '%s, ' "${summary[@]}")
+  git commit -q -m "Long runs in progress (not results): records stored: ${joined%, }" -- "${paths[@]}"
   git log --oneline -1
 }
 
