@@ -7,8 +7,11 @@
 #                                             yes), niced, in the background, each with a '=== resumed
 #                                             ...' line in its log
 #   bash results/long_runs.sh stop [NAME...]  SIGTERM (a drum run resumes from its last checkpoint, at most
-#                                             --checkpoint-every = 120 s of wall behind), and wait for the end
-#   bash results/long_runs.sh commit          commit the runs' folders (only those paths), if they changed
+#                                             --checkpoint-every = 120 s of wall behind), wait for the end,
+#                                             then commit, with the checkpoints: run it before a session stops
+#   bash results/long_runs.sh commit [--checkpoints]
+#                                             commit the runs' folders (only those paths), if they changed;
+#                                             the runs' checkpoints too with --checkpoints (see commit())
 #   bash results/long_runs.sh keep-committed [MINUTES]
 #                                             commit every MINUTES (default 20) until killed: a session's stop
 #                                             then loses at most that much of a finished simulation
@@ -82,15 +85,26 @@ stop() {
     kill -TERM "$pid" && pids+=("$pid") && echo "$(field "$r" 1): SIGTERM sent (pid $pid)"
   done
   local p; for p in "${pids[@]}"; do while kill -0 "$p" 2>/dev/null; do sleep 1; done; done
+  commit --checkpoints
 }
 
+# commit [--checkpoints]: the runs' folders, only those paths. A drum run's checkpoint (STORE/*.turn.h5,
+# ignored by git: a few MB, rewritten every 120 s) is taken only with --checkpoints, as `stop` does: a
+# later session's clone has no ignored file, so without it each stop threw away every run in flight
+# (the rerun's 4 rpm run of candidate 4 lost 1 823 s of wall so at stop 50). Taken at each stop only, it
+# adds a few MB a stop to the repository, not a few MB every 20 minutes; git drops it from the tree once
+# the run has stored its record and removed it.
 commit() {
-  local r paths=() summary=()
+  local r paths=() summary=() checkpoints=()
   for r in "${runs[@]}"; do paths+=("$(field "$r" 2)"); summary+=("$(field "$r" 1) $(records "$r")"); done
   git add -A -- "${paths[@]}"
+  if [ "${1:-}" = --checkpoints ]; then
+    mapfile -t checkpoints < <(find "${paths[@]}" -path '*/store/*.turn.h5' 2>/dev/null)
+    [ ${#checkpoints[@]} -eq 0 ] || git add -f -- "${checkpoints[@]}"
+  fi
   if git diff --cached --quiet -- "${paths[@]}"; then echo "long_runs.sh: nothing new to commit"; return 0; fi
   local joined; joined=$(printf '%s, ' "${summary[@]}")
-  git commit -q -m "Long runs in progress (not results): records stored: ${joined%, }" -- "${paths[@]}"
+  git commit -q -m "Long runs in progress (not results): records stored: ${joined%, }${checkpoints:+; with the checkpoints of the runs in flight (${#checkpoints[@]})}" -- "${paths[@]}"
   git log --oneline -1
 }
 
@@ -109,7 +123,7 @@ case $cmd in
   status) status ;;
   start) known "$@"; start "$@" ;;
   stop) known "$@"; stop "$@" ;;
-  commit) commit ;;
+  commit) commit "$@" ;;
   keep-committed) keep_committed "$@" ;;
   -h | --help | help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//' ;;
   *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, commit, keep-committed; --help)" >&2; exit 2 ;;
