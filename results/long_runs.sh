@@ -44,10 +44,14 @@ selected() { # selected ROW NAME...: the row is among the names given (when none
 known() { local n r; for n in "$@"; do for r in "${runs[@]}"; do [ "$(field "$r" 1)" = "$n" ] && continue 2; done
   echo "long_runs.sh: no run named '$n' (runs: $(for r in "${runs[@]}"; do printf '%s ' "$(field "$r" 1)"; done))" >&2; exit 2; done; }
 # The pid of a run's command (its parent process, the lowest pid: workers are its forked children, with
-# the same command line), empty if none runs; whatever path the binary was started by.
+# the same command line), empty if none runs: whatever path the binary was started by, and only a process
+# working in this checkout (another clone's run of the same command is not this one's).
 pid_of() {
-  local args; args=$(field "$1" 6 | cut -d' ' -f2- | sed 's/[][\\.*^$+?(){}|]/\\&/g')
-  pgrep -f -- "(^|/)granucal $args\$" | head -1 || true
+  local args pid here; args=$(field "$1" 6 | cut -d' ' -f2- | sed 's/[][\\.*^$+?(){}|]/\\&/g')
+  here=$(pwd -P)
+  for pid in $(pgrep -f -- "(^|/)granucal $args\$" || true); do
+    [ "$(readlink "/proc/$pid/cwd" 2>/dev/null)" = "$here" ] && { echo "$pid"; return; }
+  done
 }
 records() { find "$(field "$1" 2)" -path '*/store/*.yaml' 2>/dev/null | wc -l; }
 
