@@ -52,6 +52,7 @@ pid_of() {
   for pid in $(pgrep -f -- "(^|/)granucal $args\$" || true); do
     [ "$(readlink "/proc/$pid/cwd" 2>/dev/null)" = "$here" ] && { echo "$pid"; return; }
   done
+  return 0
 }
 records() { find "$(field "$1" 2)" -path '*/store/*.yaml' 2>/dev/null | wc -l; }
 
