@@ -22,7 +22,9 @@
 # Each run is one worker, one thread (OMP_NUM_THREADS=1, --jobs 1): on this 2-core machine two runs side
 # by side use it fully, where a lone run on two threads turns only 1.29-1.47x faster
 # (results/benchmarks/threads_2core/). NICE: a run's share when a test suite or a third run competes.
-# A run is listed here while its README says IN PROGRESS; take it out when it is done.
+# A run is listed here while its README says IN PROGRESS; take it out when it is done. twin-calibration
+# (step 2 of results/twin_standard/README.md) waits for twin-data's files; its README says how its store
+# is seeded first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 granucal=${GRANUCAL:-build/granucal}
@@ -32,6 +34,7 @@ granucal=${GRANUCAL:-build/granucal}
 runs=(
   "rerun|results/calibration-standard-r2|results/calibration-standard-r2/run.log|10|yes|$granucal calibrate configs/calibration.yaml --tier standard --jobs 1 --out results/calibration-standard-r2"
   "twin-data|results/twin_standard|results/twin_standard/data/run.log|10|yes|$granucal synthesize configs/calibration.yaml --tier standard --seeds 101,102,103 --granule 0.8,0.2 --k-n 200 --wall aluminium=0.8,0.2 --wall PP=0.9,0.0001 --wall PTFE=0.9,0.0001 --out results/twin_standard/data --jobs 1"
+  "twin-calibration|results/twin_standard|results/twin_standard/calibration/run.log|10|waits|$granucal calibrate configs/calibration.yaml --tier standard --data results/twin_standard/data --jobs 1 --out results/twin_standard/calibration"
   "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
 )
 field() { cut -d'|' -f"$2" <<< "$1"; }
@@ -54,14 +57,15 @@ pid_of() {
   done
   return 0
 }
-records() { find "$(field "$1" 2)" -path '*/store/*.yaml' 2>/dev/null | wc -l; }
+# A run's records: its store beside its log.
+records() { find "$(dirname "$(field "$1" 3)")/store" -name '*.yaml' 2>/dev/null | wc -l; }
 
 status() {
   local r pid
   for r in "${runs[@]}"; do
     pid=$(pid_of "$r")
-    printf '%-15s %-9s %4d records  %s\n' "$(field "$r" 1)" "${pid:+running}" "$(records "$r")" "$(field "$r" 2)"
-    printf '                %s\n' "$(tail -1 "$(field "$r" 3)" 2>/dev/null | cut -c1-150)"
+    printf '%-17s %-8s %4d records  %s\n' "$(field "$r" 1)" "${pid:+running}" "$(records "$r")" "$(field "$r" 2)"
+    printf '                  %s\n' "$(tail -1 "$(field "$r" 3)" 2>/dev/null | cut -c1-150)"
   done
 }
 
@@ -73,6 +77,7 @@ start() {
     selected "$r" yes "$@" || continue
     [ -z "$(pid_of "$r")" ] || { echo "$(field "$r" 1): already running"; continue; }
     log=$(field "$r" 3) when=$(date -u +%Y-%m-%dT%H:%M:%SZ)
+    mkdir -p "$(dirname "$log")"
     echo "=== resumed $when by $commit (results/long_runs.sh, nice $(field "$r" 4), one worker) ===" >> "$log"
     # shellcheck disable=SC2086 # the command is words
     OMP_NUM_THREADS=1 nohup nice -n "$(field "$r" 4)" $(field "$r" 6) >> "$log" 2>&1 < /dev/null &
