@@ -38,8 +38,10 @@ runs=(
   "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
 )
 field() { cut -d'|' -f"$2" <<< "$1"; }
-selected() { # selected ROW NAME...: the row is among the names given (when none: every row, or with
-  local row=$1 default=$2; shift 2 # DEFAULT yes, those a plain start starts)
+# selected ROW DEFAULT NAME...: the row is one of the names given; with none given, every row (DEFAULT
+# all) or those whose fifth field is yes (DEFAULT yes: what a plain start starts).
+selected() {
+  local row=$1 default=$2; shift 2
   [ $# -eq 0 ] && { [ "$default" = all ] || [ "$(field "$row" 5)" = yes ]; return; }
   local n; for n in "$@"; do [ "$(field "$row" 1)" = "$n" ] && return 0; done
   return 1
@@ -101,7 +103,7 @@ stop() {
 # commit [--checkpoints]: the runs' folders, only those paths. A drum run's checkpoint (STORE/*.turn.h5,
 # ignored by git: a few MB, rewritten every 120 s) is taken only with --checkpoints, as `stop` does: a
 # later session's clone has no ignored file, so without it each stop threw away every run in flight
-# (the rerun's 4 rpm run of candidate 4 lost 1 823 s of wall so at stop 50). Taken at each stop only, it
+# (the rerun's 4 rpm run of candidate 4 lost 1 823 s of wall that way at stop 50). Taken at each stop only, it
 # adds a few MB a stop to the repository, not a few MB every 20 minutes; git drops it from the tree once
 # the run has stored its record and removed it.
 commit() {
