@@ -21,7 +21,7 @@ phase_done() { local now; now=$(date +%s); phases+="$(printf '%-28s %5d s' "$1" 
 release_log=build/release-tests.log
 slowest() {
   [ -f "$release_log" ] || return 0
-  echo "run_all.sh: the Release pass's 15 slowest tests (wall s, three slots on two cores):"
+  echo "run_all.sh: the Release pass's 15 slowest tests (wall s; $((jobs + 1)) slots on $jobs cores):"
   # (|| true: no line found, or head closing the pipe early, must not end the trap before the phases)
   grep -E "Test +#[0-9]+: " "$release_log" | sed -E 's/.*Test +#[0-9]+: ([^ ]+) .* ([0-9.]+) sec$/\2 \1/' |
     sort -rn | head -15 || true
