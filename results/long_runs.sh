@@ -59,8 +59,11 @@ pid_of() {
   done
   return 0
 }
-# A run's records: its store beside its log.
-records() { find "$(dirname "$(field "$1" 3)")/store" -name '*.yaml' 2>/dev/null | wc -l; }
+# A run's records: its store beside its log (0 for a run not started: no store yet).
+records() {
+  local store; store=$(dirname "$(field "$1" 3)")/store
+  if [ -d "$store" ]; then find "$store" -name '*.yaml' | wc -l; else echo 0; fi
+}
 
 status() {
   local r pid
