@@ -39,7 +39,7 @@ phase_done "setup and Release build"
 # One ctest slot more than the cores: a two-core test (a calibration on 2 workers) keeps only 1.2-1.6
 # of its cores busy (its batches' last runs, derivations and outputs are serial), and with as many
 # slots as cores nothing starts beside it; the extra slot lets a single-core test fill the idle core
-# (on a subset of 15 tests, 531 s -> 456 s, the same CPU: results/benchmarks/ci_time.md). OpenMP
+# (on a subset of 15 tests, 538 s -> 468 s on two runs each, the same CPU: results/benchmarks/ci_time.md). OpenMP
 # threads then sleep at a barrier rather than spin (OMP_WAIT_POLICY=passive): a lone simulation the
 # pool grants two threads may share the cores with a third process, where spinning threads once ran
 # 10x slower. Results do not depend on either (one order of sums on any thread count).
