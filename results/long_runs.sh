@@ -129,7 +129,7 @@ keep_committed() {
   while sleep $((minutes * 60)); do
     # another git command holding the index: try again shortly instead of failing the loop
     local try; for try in 1 2 3 4 5 6; do [ -e .git/index.lock ] && sleep 10 || break; done
-    commit || true
+    commit || echo "long_runs.sh: commit failed at $(date -u +%H:%M:%SZ) (exit $?); the loop goes on" >&2
   done
 }
 
