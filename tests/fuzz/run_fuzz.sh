@@ -93,8 +93,8 @@ fuzz_one() {
 status=0
 parallel=$(( $(nproc) >= ${#kinds[@]} ))
 pids=()
+mkdir -p "$build/run"
 for kind in "${kinds[@]}"; do
-  mkdir -p "$build/run"
   if [ "$parallel" -eq 1 ]; then
     fuzz_one "$kind" >"$build/run/$kind.out" 2>&1 & pids+=($!)
   else
