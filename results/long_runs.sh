@@ -12,6 +12,10 @@
 #   bash results/long_runs.sh commit [--checkpoints]
 #                                             commit the runs' folders (only those paths), if they changed;
 #                                             the runs' checkpoints too with --checkpoints (see commit())
+#   bash results/long_runs.sh chain FIRST NEXT
+#                                             wait while FIRST runs, then start NEXT, unless FIRST was
+#                                             stopped (its log's last '===' line): run it with nohup, so that
+#                                             a core freed between two looks at the session is not left idle
 #   bash results/long_runs.sh keep-committed [MINUTES]
 #                                             commit every MINUTES (default 20) until killed: a session's stop
 #                                             then loses at most that much of a finished simulation
@@ -30,11 +34,12 @@ cd "$(dirname "$0")/.."
 granucal=${GRANUCAL:-build/granucal}
 
 # name | folder committed | log | nice | started by a plain `start` (yes) or only by name (waits: no core
-# for it while the others run) | command (from the repository root)
+# for it while the others run) | command (from the repository root) | what its start does first, if
+# anything (run each start: it must leave what is already there as it is)
 runs=(
   "rerun|results/calibration-standard-r2|results/calibration-standard-r2/run.log|10|yes|$granucal calibrate configs/calibration.yaml --tier standard --jobs 1 --out results/calibration-standard-r2"
   "twin-data|results/twin_standard|results/twin_standard/data/run.log|10|yes|$granucal synthesize configs/calibration.yaml --tier standard --seeds 101,102,103 --granule 0.8,0.2 --k-n 200 --wall aluminium=0.8,0.2 --wall PP=0.9,0.0001 --wall PTFE=0.9,0.0001 --out results/twin_standard/data --jobs 1"
-  "twin-calibration|results/twin_standard|results/twin_standard/calibration/run.log|10|waits|$granucal calibrate configs/calibration.yaml --tier standard --data results/twin_standard/data --jobs 1 --out results/twin_standard/calibration"
+  "twin-calibration|results/twin_standard|results/twin_standard/calibration/run.log|10|waits|$granucal calibrate configs/calibration.yaml --tier standard --data results/twin_standard/data --jobs 1 --out results/twin_standard/calibration|mkdir -p results/twin_standard/calibration/store && cp -n results/calibration-standard-r2/store/*.yaml results/calibration-standard-r2/store/*.start.h5 results/twin_standard/calibration/store/"
   "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
 )
 field() { cut -d'|' -f"$2" <<< "$1"; }
@@ -83,6 +88,10 @@ start() {
     [ -z "$(pid_of "$r")" ] || { echo "$(field "$r" 1): already running"; continue; }
     log=$(field "$r" 3) when=$(date -u +%Y-%m-%dT%H:%M:%SZ)
     mkdir -p "$(dirname "$log")"
+    if [ -n "$(field "$r" 7)" ]; then
+      echo "$(field "$r" 1): first: $(field "$r" 7)"
+      bash -c "$(field "$r" 7)"
+    fi
     echo "=== resumed $when by $commit (results/long_runs.sh, nice $(field "$r" 4), one worker) ===" >> "$log"
     # shellcheck disable=SC2086 # the command is words
     OMP_NUM_THREADS=1 nohup nice -n "$(field "$r" 4)" $(field "$r" 6) >> "$log" 2>&1 < /dev/null &
@@ -123,6 +132,22 @@ commit() {
   git log --oneline -1
 }
 
+# chain FIRST NEXT: NEXT starts once FIRST's process is gone, unless FIRST's log says it was stopped
+# (`stop` writes '=== stopped' there; a run that ended by itself leaves its own last line after the
+# '=== resumed' one).
+chain() {
+  [ $# -eq 2 ] || { echo "long_runs.sh: chain FIRST NEXT" >&2; exit 2; }
+  known "$1" "$2"
+  local r first=""; for r in "${runs[@]}"; do [ "$(field "$r" 1)" = "$1" ] && first=$r; done
+  while [ -n "$(pid_of "$first")" ]; do sleep 60; done
+  local last; last=$(grep '^===' "$(field "$first" 3)" | tail -n 1 || true)
+  if [[ $last == "=== stopped"* ]]; then
+    echo "long_runs.sh: $1 was stopped, so $2 is not started"; return 0
+  fi
+  echo "long_runs.sh: $1 ended at $(date -u +%H:%M:%SZ): its log's end:"; tail -3 "$(field "$first" 3)"
+  start "$2"
+}
+
 keep_committed() {
   local minutes=${1:-20}
   [[ "$minutes" =~ ^[0-9]+$ ]] && [ "$minutes" -gt 0 ] || { echo "long_runs.sh: MINUTES must be a positive integer" >&2; exit 2; }
@@ -139,7 +164,8 @@ case $cmd in
   start) known "$@"; start "$@" ;;
   stop) known "$@"; stop "$@" ;;
   commit) commit "$@" ;;
+  chain) chain "$@" ;;
   keep-committed) keep_committed "$@" ;;
   -h | --help | help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//' ;;
-  *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, commit, keep-committed; --help)" >&2; exit 2 ;;
+  *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, chain, commit, keep-committed; --help)" >&2; exit 2 ;;
 esac
