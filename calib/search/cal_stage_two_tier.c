@@ -319,6 +319,9 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     out->posterior_runs_outcome = cal_mf_refine(&map, &p, t->posterior_runs, posterior_next, &tt, m);
     out->posterior_runs = m->n - loop_runs;
     if (out->posterior_runs > 0 && t->return_runs > 0) {
+        // Said here, as each of the loop's other runs says why it is where it is.
+        fprintf(stderr, "-- back where the corrected map, with the posterior's %d run(s) in it, puts the optimum "
+                        "(return_runs: at most %d)\n", out->posterior_runs, t->return_runs);
         out->return_runs = cal_mf_return(&map, &p, t->return_runs, m);
         out->return_outcome = outcome_of(m);
     }
