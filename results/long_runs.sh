@@ -2,7 +2,8 @@
 # The lab book's runs in progress: one home for their commands, so that a session resumes them as the
 # last one left them, says where they stand, and commits their stores before it stops.
 #
-#   bash results/long_runs.sh status          each run: running or not, records stored, its log's last line
+#   bash results/long_runs.sh status          each run: running or not, records stored, its log's last line,
+#                                             and what its own --plan says is left (it runs nothing)
 #   bash results/long_runs.sh start [NAME...] resume those not running (by default those the table marks
 #                                             yes), niced, in the background, each with a '=== resumed
 #                                             ...' line in its log
@@ -70,12 +71,24 @@ records() {
   if [ -d "$store" ]; then find "$store" -name '*.yaml' | wc -l; else echo 0; fi
 }
 
+# What a run's own --plan says is left (from its '== left' line): --plan replays the store and
+# runs and writes nothing, so it is safe beside the run itself.
+left() {
+  [ -x "$granucal" ] || { echo "(not built: no plan)"; return 0; }
+  # shellcheck disable=SC2046 # the command is words
+  local plan; plan=$(OMP_NUM_THREADS=1 $(field "$1" 6) --plan 2>&1 || true)
+  if grep -q '^== left' <<< "$plan"; then
+    grep '^== left' <<< "$plan" | sed -E 's/.*[Ee]xpected left: /its plan: left /; s/ \(each (step|lining).*//'
+  else echo "its plan: none ($(tail -1 <<< "$plan" | cut -c1-120))"; fi
+}
+
 status() {
   local r pid
   for r in "${runs[@]}"; do
     pid=$(pid_of "$r")
     printf '%-17s %-8s %4d records  %s\n' "$(field "$r" 1)" "${pid:+running}" "$(records "$r")" "$(field "$r" 2)"
     printf '                  %s\n' "$(tail -1 "$(field "$r" 3)" 2>/dev/null | cut -c1-150)"
+    printf '                  %s\n' "$(left "$r")"
   done
 }
 
