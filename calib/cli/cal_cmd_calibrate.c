@@ -154,12 +154,14 @@ static int parse_options(int argc, char **argv, options *o)
 
 typedef struct stage_file {
     double k_n, mu_s, mu_r;
+    char *k_n_from; ///< stage_stiffness.yaml: "stage 1" (its choice) or "config" (unresolved); absent before stop 53
     double mu_s_identified_min, mu_s_identified_max, mu_r_identified_min, mu_r_identified_max; ///< absent: 0
     double mu_s_not_excluded_min, mu_s_not_excluded_max, mu_r_not_excluded_min, mu_r_not_excluded_max; ///< absent: 0
 } stage_file;
 #define STAGE_FLOAT(key, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_OPTIONAL, stage_file, member)
 static const cyaml_schema_field_t stage_fields[] = {
     STAGE_FLOAT("k_n", k_n), STAGE_FLOAT("mu_s", mu_s), STAGE_FLOAT("mu_r", mu_r),
+    CYAML_FIELD_STRING_PTR("k_n_from", CYAML_FLAG_OPTIONAL | CYAML_FLAG_POINTER, stage_file, k_n_from, 1, 15),
     STAGE_FLOAT("mu_s_identified_min", mu_s_identified_min), STAGE_FLOAT("mu_s_identified_max", mu_s_identified_max),
     STAGE_FLOAT("mu_r_identified_min", mu_r_identified_min), STAGE_FLOAT("mu_r_identified_max", mu_r_identified_max),
     STAGE_FLOAT("mu_s_not_excluded_min", mu_s_not_excluded_min), STAGE_FLOAT("mu_s_not_excluded_max", mu_s_not_excluded_max),
@@ -167,9 +169,13 @@ static const cyaml_schema_field_t stage_fields[] = {
     CYAML_FIELD_END};
 static const cyaml_schema_value_t stage_schema = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, stage_file, stage_fields)};
 
-// ranges: the identified μs and μr ranges, or NULL (stage 1).
+// The two values of a stage 1 file's k_n_from.
+static const char K_N_FROM_STAGE_1[] = "stage 1", K_N_FROM_CONFIG[] = "config";
+
+// ranges: the identified μs and μr ranges, or NULL (stage 1); k_n_from: whether
+// stage 1 chose k_n or fell back to the config's (NULL: a friction stage's file).
 static int write_stage(const char *dir, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2],
-                       char *err, size_t len)
+                       const char *k_n_from, char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
@@ -179,6 +185,7 @@ static int write_stage(const char *dir, const char *name, double k_n, double mu_
                  "freezes,\n# whatever its status (a bound, not a result); what each value is: calibrated_parameters.*\n"
                  "k_n: %.17g\nmu_s: %.17g\nmu_r: %.17g\n",
             k_n, mu_s, mu_r);
+    if (k_n_from) fprintf(a.f, "k_n_from: %s\n", k_n_from);
     if (ranges && isfinite(ranges[1].lo))
         fprintf(a.f, "mu_s_identified_min: %.17g\nmu_s_identified_max: %.17g\nmu_r_identified_min: %.17g\n"
                      "mu_r_identified_max: %.17g\nmu_s_not_excluded_min: %.17g\nmu_s_not_excluded_max: %.17g\n"
@@ -200,16 +207,23 @@ static void stage_ranges(const stage_file *s, cal_range *mu_s, cal_range *mu_r)
     mu_r->bracket_lo = s->mu_r_not_excluded_min, mu_r->bracket_hi = s->mu_r_not_excluded_max;
 }
 
-// 1 if the stage file exists and was read; -1 if it is damaged.
-static int read_stage(const char *dir, const char *name, stage_file *out, char *err, size_t len)
+// 1 if the stage file exists and was read; -1 if it is damaged. k_n_chosen
+// (may be NULL): 1 if stage 1 chose its k_n, 0 if it is the config's, -1 if the
+// file does not say (written before k_n_from was kept).
+static int read_stage(const char *dir, const char *name, stage_file *out, int *k_n_chosen, char *err, size_t len)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/stage_%s.yaml", dir, name);
     if (access(path, F_OK) != 0) return 0;
     stage_file *s = NULL;
     if (exp_yaml_load(path, &stage_schema, (void **)&s, "delete it to rerun that stage", err, len)) return -1;
-    *out = *s;
+    int chosen = !s->k_n_from ? -1 : strcmp(s->k_n_from, K_N_FROM_STAGE_1) == 0 ? 1 : strcmp(s->k_n_from, K_N_FROM_CONFIG) == 0 ? 0 : -2;
+    *out = *s, out->k_n_from = NULL; // the string goes with s
     exp_yaml_free(&stage_schema, s);
+    if (chosen == -2)
+        return exp_fail(err, len, "%s: field 'k_n_from': expected '%s' or '%s' (delete the file to rerun that stage)", path,
+                        K_N_FROM_STAGE_1, K_N_FROM_CONFIG), -1;
+    if (k_n_chosen) *k_n_chosen = chosen;
     return 1;
 }
 
@@ -322,10 +336,11 @@ static int prepare(run *r)
 
 // A stage's pair for later stages run alone: written by rank 0, and never by a
 // plan's replay of the store (which writes nothing).
-static int save_stage(run *r, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2])
+static int save_stage(run *r, const char *name, double k_n, double mu_s, double mu_r, const cal_range ranges[2],
+                      const char *k_n_from)
 {
     if (cal_mpi_rank() != 0 || r->env.store_only) return 0;
-    return write_stage(r->out, name, k_n, mu_s, mu_r, ranges, r->err, sizeof r->err);
+    return write_stage(r->out, name, k_n, mu_s, mu_r, ranges, k_n_from, r->err, sizeof r->err);
 }
 
 static int wants(const run *r, const char *stage) { return strcmp(r->opt.stage, "all") == 0 || strcmp(r->opt.stage, stage) == 0; }
@@ -346,18 +361,25 @@ static int stage_stiffness(run *r, double *k_n, const char **source)
             fprintf(stderr, "stage 1: the CN of the softest candidate is within the noise of the stiff limit: the sweep "
                             "does not resolve the stiffness at this tier; using the config's k_n = %g N/m\n", r->c->k_n);
             *source = "config k_n (stage 1 unresolved at this tier: CN flat within its noise)";
-            return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL);
+            return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL, K_N_FROM_CONFIG);
         }
         *k_n = r->stiffness.chosen_k, r->table.k_calibrated = 1;
         *source = drum ? "stage 1 (the drum's poured bed, Fig. 12)" : "stage 1 (poured cylinder, Fig. 12)";
-        return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL);
+        return save_stage(r, "stiffness", *k_n, NAN, NAN, NULL, K_N_FROM_STAGE_1);
     }
     stage_file s;
-    int got = read_stage(r->out, "stiffness", &s, r->err, sizeof r->err);
+    int chosen;
+    int got = read_stage(r->out, "stiffness", &s, &chosen, r->err, sizeof r->err);
     if (got < 0) return 1;
-    // An unresolved sweep stores the config's k_n too: only a k_n unlike the
-    // config's is known to be stage 1's choice.
-    if (got) *k_n = s.k_n, *source = "stage 1, earlier run (stage_stiffness.yaml)", r->table.k_calibrated = s.k_n != r->c->k_n;
+    if (!got) return 0;
+    *k_n = s.k_n;
+    // An unresolved sweep stores the config's k_n too. The file says which
+    // (k_n_from); one written before it did is known to hold stage 1's choice
+    // only where that differs from the config's k_n.
+    r->table.k_calibrated = chosen >= 0 ? chosen : s.k_n != r->c->k_n;
+    *source = chosen == 0                 ? "config k_n (stage 1 of an earlier run unresolved: stage_stiffness.yaml)"
+              : r->table.k_calibrated ? "stage 1, earlier run (stage_stiffness.yaml)"
+                                      : "stage_stiffness.yaml of an earlier run, which does not say whether stage 1 chose it";
     return 0;
 }
 
@@ -401,10 +423,10 @@ static int stage_granule(run *r, double k_n, double *mu_s, double *mu_r, const c
         *source = friction_source(r->granule, sources);
         r->table.gg_angle_matched = cal_candidate_angle_matched(&r->granule->cand[r->granule->best]);
         const cal_range ranges[2] = {r->granule->mu_s_range, r->granule->mu_r_range};
-        return save_stage(r, "granule", k_n, *mu_s, *mu_r, ranges);
+        return save_stage(r, "granule", k_n, *mu_s, *mu_r, ranges, NULL);
     }
     stage_file s;
-    int got = read_stage(r->out, "granule", &s, r->err, sizeof r->err);
+    int got = read_stage(r->out, "granule", &s, NULL, r->err, sizeof r->err);
     if (got < 0) return 1;
     if (got) {
         *mu_s = s.mu_s, *mu_r = s.mu_r, *source = "stage 2, earlier run (stage_granule.yaml)";
@@ -564,7 +586,7 @@ static void plan_stiffness(run *r, plan *p)
     }
     stage_file sf;
     char err[512];
-    if (read_stage(r->out, "stiffness", &sf, err, sizeof err) == 1 && sf.k_n > 0) {
+    if (read_stage(r->out, "stiffness", &sf, NULL, err, sizeof err) == 1 && sf.k_n > 0) {
         p->k_expected = p->k_worst = sf.k_n;
         snprintf(p->k_source, sizeof p->k_source, "stage 1 of an earlier run (%s/stage_stiffness.yaml)", r->out);
     }
