@@ -823,8 +823,8 @@ static void grid_range(map_grid *g)
 // qhull, under plgriddata's triangulation, ends the process on input whose
 // first sites lie on one circle (a search's 2 × 2 start grid is a square), so
 // every site is moved by a fixed pseudo-random amount of at most 5e-6 of the
-// axes: no four sites stay cocircular, and no pixel moves (a map node is 3e-3
-// of an axis). At 5e-8 the sites were still so nearly cocircular that qhull
+// axes: no four sites stay cocircular, and none moves by a hundredth of a
+// pixel (a map node is 3e-3 of an axis). At 5e-8 the sites were still so nearly cocircular that qhull
 // printed a "precision warning: The initial hull is narrow" into every log of
 // a run whose map was its 2 × 2 grid alone.
 static void joggle(size_t n, double *u, double *v)
