@@ -154,7 +154,7 @@ static int parse_options(int argc, char **argv, options *o)
 
 typedef struct stage_file {
     double k_n, mu_s, mu_r;
-    char *k_n_from; ///< stage_stiffness.yaml: "stage 1" (its choice) or "config" (unresolved); absent before stop 53
+    char *k_n_from; ///< stage_stiffness.yaml: "stage 1" (its choice) or "config" (unresolved); absent in older files
     double mu_s_identified_min, mu_s_identified_max, mu_r_identified_min, mu_r_identified_max; ///< absent: 0
     double mu_s_not_excluded_min, mu_s_not_excluded_max, mu_r_not_excluded_min, mu_r_not_excluded_max; ///< absent: 0
 } stage_file;
@@ -217,7 +217,10 @@ static int read_stage(const char *dir, const char *name, stage_file *out, int *k
     if (access(path, F_OK) != 0) return 0;
     stage_file *s = NULL;
     if (exp_yaml_load(path, &stage_schema, (void **)&s, "delete it to rerun that stage", err, len)) return -1;
-    int chosen = !s->k_n_from ? -1 : strcmp(s->k_n_from, K_N_FROM_STAGE_1) == 0 ? 1 : strcmp(s->k_n_from, K_N_FROM_CONFIG) == 0 ? 0 : -2;
+    int chosen = !s->k_n_from                              ? -1
+                 : strcmp(s->k_n_from, K_N_FROM_STAGE_1) == 0 ? 1
+                 : strcmp(s->k_n_from, K_N_FROM_CONFIG) == 0  ? 0
+                                                              : -2;
     *out = *s, out->k_n_from = NULL; // the string goes with s
     exp_yaml_free(&stage_schema, s);
     if (chosen == -2)
