@@ -27,9 +27,9 @@
 # Each run is one worker, one thread (OMP_NUM_THREADS=1, --jobs 1): on this 2-core machine two runs side
 # by side use it fully, where a lone run on two threads turns only 1.29-1.47x faster
 # (results/benchmarks/threads_2core/). NICE: a run's share when a test suite or a third run competes.
-# A run is listed here while its README says IN PROGRESS; take it out when it is done. twin-calibration
-# (step 2 of results/twin_standard/README.md) waits for twin-data's files; its README says how its store
-# is seeded first.
+# A run is listed here while its README says IN PROGRESS; take it out when it is done (twin-data, the
+# twin's synthesis, ended 2026-12-02: results/twin_standard/README.md). twin-calibration (step 2 there)
+# seeds its store from the rerun's before its first start (the row's last field).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 granucal=${GRANUCAL:-build/granucal}
@@ -39,7 +39,6 @@ granucal=${GRANUCAL:-build/granucal}
 # anything (run each start: it must leave what is already there as it is)
 runs=(
   "rerun|results/calibration-standard-r2|results/calibration-standard-r2/run.log|10|yes|$granucal calibrate configs/calibration.yaml --tier standard --jobs 1 --out results/calibration-standard-r2"
-  "twin-data|results/twin_standard|results/twin_standard/data/run.log|10|yes|$granucal synthesize configs/calibration.yaml --tier standard --seeds 101,102,103 --granule 0.8,0.2 --k-n 200 --wall aluminium=0.8,0.2 --wall PP=0.9,0.0001 --wall PTFE=0.9,0.0001 --out results/twin_standard/data --jobs 1"
   "twin-calibration|results/twin_standard|results/twin_standard/calibration/run.log|10|waits|$granucal calibrate configs/calibration.yaml --tier standard --data results/twin_standard/data --jobs 1 --out results/twin_standard/calibration|mkdir -p results/twin_standard/calibration/store && cp -n results/calibration-standard-r2/store/*.yaml results/calibration-standard-r2/store/*.start.h5 results/twin_standard/calibration/store/"
   "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
 )
@@ -171,14 +170,20 @@ keep_committed() {
   done
 }
 
-cmd=${1:-status}; shift || true
-case $cmd in
-  status) status ;;
-  start) known "$@"; start "$@" ;;
-  stop) known "$@"; stop "$@" ;;
-  commit) commit "$@" ;;
-  chain) chain "$@" ;;
-  keep-committed) keep_committed "$@" ;;
-  -h | --help | help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//' ;;
-  *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, chain, commit, keep-committed; --help)" >&2; exit 2 ;;
-esac
+main() {
+  local cmd=${1:-status}; shift || true
+  case $cmd in
+    status) status ;;
+    start) known "$@"; start "$@" ;;
+    stop) known "$@"; stop "$@" ;;
+    commit) commit "$@" ;;
+    chain) chain "$@" ;;
+    keep-committed) keep_committed "$@" ;;
+    -h | --help | help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//' ;;
+    *) echo "long_runs.sh: unknown command '$cmd' (status, start, stop, chain, commit, keep-committed; --help)" >&2; exit 2 ;;
+  esac
+}
+# One line, read whole before it runs: a chain or keep-committed runs for hours, and bash reads a script
+# as it goes, so without the exit on this line an edit of this file meanwhile had the ended command read
+# on at its old offset (a chain ended in a syntax error, stop 53).
+main "$@"; exit
