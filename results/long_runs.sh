@@ -53,14 +53,21 @@ selected() {
 }
 known() { local n r; for n in "$@"; do for r in "${runs[@]}"; do [ "$(field "$r" 1)" = "$n" ] && continue 2; done
   echo "long_runs.sh: no run named '$n' (runs: $(for r in "${runs[@]}"; do printf '%s ' "$(field "$r" 1)"; done))" >&2; exit 2; done; }
-# The pid of a run's command (its parent process, the lowest pid: workers are its forked children, with
-# the same command line), empty if none runs: whatever path the binary was started by, and only a process
-# working in this checkout (another clone's run of the same command is not this one's).
+# The pid of a run's command, empty if none runs: its parent process, the one whose own parent is not
+# another of the same command (workers are its forked children, with the same command line). Not the
+# lowest pid: once the pids wrap round a worker's can be lower, and a stop at stop 53 sent SIGTERM to
+# the workers alone. Whatever path the binary was started by, and only a process working in this
+# checkout (another clone's run of the same command is not this one's).
 pid_of() {
-  local args pid here; args=$(field "$1" 6 | cut -d' ' -f2- | sed 's/[][\\.*^$+?(){}|]/\\&/g')
+  local args pid here parent mine=()
+  args=$(field "$1" 6 | cut -d' ' -f2- | sed 's/[][\\.*^$+?(){}|]/\\&/g')
   here=$(pwd -P)
   for pid in $(pgrep -f -- "(^|/)granucal $args\$" || true); do
-    [ "$(readlink "/proc/$pid/cwd" 2>/dev/null)" = "$here" ] && { echo "$pid"; return; }
+    [ "$(readlink "/proc/$pid/cwd" 2>/dev/null)" = "$here" ] && mine+=("$pid")
+  done
+  for pid in "${mine[@]}"; do
+    parent=$(ps -o ppid= -p "$pid" 2>/dev/null | tr -d ' ')
+    [[ " ${mine[*]} " == *" $parent "* ]] || { echo "$pid"; return; }
   done
   return 0
 }
