@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "cal_options.h"
+#include "capture_fd.h"
 
 typedef struct values {
     int flag, whole, n_list;
@@ -61,18 +62,10 @@ static int parse(values *v, char **argv, int fd, char *said, size_t len, char **
                              .n_options = n, .operand = "FILE", .min_operands = 1, .max_operands = 2};
     int argc = 0;
     while (argv[argc]) ++argc;
-    FILE *capture = tmpfile();
-    assert_non_null(capture);
-    fflush(fd == 1 ? stdout : stderr);
-    int saved = dup(fd);
-    dup2(fileno(capture), fd);
+    capture_fd capture;
+    assert_int_equal(capture_begin(&capture, fd), 0);
     int status = cal_options_parse(&line, argc, argv, operands, n_operands);
-    fflush(fd == 1 ? stdout : stderr);
-    dup2(saved, fd), close(saved);
-    rewind(capture);
-    size_t got = fread(said, 1, len - 1, capture);
-    said[got] = 0;
-    fclose(capture);
+    capture_end(&capture, said, len);
     return status;
 }
 

@@ -19,6 +19,7 @@
 #include <math.h>
 #include <png.h>
 
+#include "capture_fd.h"
 #include "cal_data.h"
 #include "cal_figures.h"
 #include "exp_plot.h"
@@ -389,18 +390,10 @@ static void map_of_a_square_grid(void **state)
                       .band_label = "band", .chosen = 2};
     char path[1200], err[512], said[4096] = "";
     path_in_dir(path, sizeof path, "map_square_grid.png");
-    FILE *captured = tmpfile();
-    assert_non_null(captured);
-    fflush(stderr);
-    int saved = dup(STDERR_FILENO);
-    assert_true(saved >= 0 && dup2(fileno(captured), STDERR_FILENO) >= 0);
+    capture_fd captured;
+    assert_int_equal(capture_begin(&captured, STDERR_FILENO), 0);
     int bad = exp_plot_map_png(path, &m, 900, 700, err, sizeof err);
-    fflush(stderr);
-    dup2(saved, STDERR_FILENO), close(saved);
-    rewind(captured);
-    size_t got = fread(said, 1, sizeof said - 1, captured);
-    said[got] = '\0';
-    fclose(captured);
+    capture_end(&captured, said, sizeof said);
     if (bad) fail_msg("%s", err);
     assert_figure("map_square_grid.png", 10000, 10);
     if (strstr(said, "qhull") || strstr(said, "QH")) fail_msg("drawing the map printed: %s", said);
