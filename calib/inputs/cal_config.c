@@ -75,6 +75,7 @@ static const cyaml_schema_field_t tier_fields[] = {
     CYAML_FIELD_INT("beds", CYAML_FLAG_OPTIONAL, cal_tier, beds),
     CYAML_FIELD_INT("posterior_runs", CYAML_FLAG_OPTIONAL, cal_tier, posterior_runs),
     CYAML_FIELD_INT("return_runs", CYAML_FLAG_OPTIONAL, cal_tier, return_runs),
+    TIER_FLOAT("angle_aim_sd", angle_aim_sd, CYAML_FLAG_OPTIONAL),
     CYAML_FIELD_ENUM_PTR("purpose", CYAML_FLAG_OPTIONAL | CYAML_FLAG_STRICT, cal_tier, demonstration, purposes,
                          CYAML_ARRAY_LEN(purposes)),
     CYAML_FIELD_END};
@@ -369,6 +370,13 @@ static int check_tier(const cal_config *c, const cal_tier *t, char *err, size_t 
         return located(c, from, "return_runs", err, len, "%d must be in [0, 16]", t->return_runs);
     if (t->return_runs && !t->posterior_runs)
         return located(c, from, "return_runs", err, len, "only a tier with posterior_runs has runs to return from");
+    if (!(t->angle_aim_sd >= 0 && t->angle_aim_sd <= 3))
+        return located(c, from, "angle_aim_sd", err, len, "%g must be in [0, 3] standard deviations", t->angle_aim_sd);
+    if (t->angle_aim_sd > 0 && !t->map_tier)
+        return located(c, from, "angle_aim_sd", err, len, "only a tier with a map_tier aims its runs on a corrected map");
+    if (t->angle_aim_sd > 0 && cal_tier_angle_in_misfit(t))
+        return located(c, from, "angle_aim_sd", err, len,
+                       "angle_rule misfit weighs the angle in the misfit: there is no band to aim inside");
     return t->map_tier ? check_map_tier(c, t, from, err, len) : 0;
 }
 
@@ -384,6 +392,7 @@ const char *cal_tier_calibration_key(const cal_tier *t)
         {"map_tier", t->map_tier != NULL},
         {"map_correction", t->map_correction != NULL}, {"beds", t->beds != 0}, {"purpose", t->demonstration != NULL},
         {"posterior_runs", t->posterior_runs != 0}, {"return_runs", t->return_runs != 0},
+        {"angle_aim_sd", t->angle_aim_sd != 0},
         {"turned_start_rpm", t->turned_start_rpm_count > 0}, {"turned_start_time", t->turned_start_time != 0}};
     for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k)
         if (keys[k].given) return keys[k].key;

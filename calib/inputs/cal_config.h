@@ -129,6 +129,16 @@ typedef struct cal_tier {
     /// resumed (cal_mf_return): those runs moved the correction, and the
     /// stage must not end on an optimum no run checked. Absent: 0.
     int return_runs;
+    /// With a map_tier: the loop (and its return runs) aims where the
+    /// corrected map's angle stands inside the angle's tolerance by this many
+    /// standard deviations of what a run there would read (the tier's run
+    /// noise and the kriging's sd of the correction, in quadrature), at most
+    /// the band's centre. 0 (absent): the band itself, where a soft penalty
+    /// puts the optimum just outside the edge the CSA pulls toward (the
+    /// standard rerun's runs 3, 4 and 7 were aimed 0.01-0.04° below its lower
+    /// edge and read 0.3-1.0° lower still). Only where the next run goes: the
+    /// stage still chooses among its runs by its angle_rule.
+    double angle_aim_sd;
     /// Beds each drum candidate is run on (seeds seed, seed+1, ...), its
     /// measurements the mean over them. angle_sd_deg and csa_sd_percent stay
     /// one bed's spreads, as measured; the search divides them by sqrt(beds)

@@ -117,6 +117,9 @@ void cal_mf_predict(const cal_mf_map *map, double u, double v, double *y)
     }
 }
 
+// The expensive runs' noise for measurement k (cal_mf_problem.run_noise; NULL: 0).
+static double tier_noise(const double *run_noise, int k) { return run_noise ? run_noise[k] : 0; }
+
 typedef struct corrected {
     const cal_mf_map *map;
     const cal_mf_correction *correction;
@@ -127,10 +130,12 @@ static double corrected_objective(unsigned n, const double *x, double *grad, voi
 {
     (void)n, (void)grad;
     const corrected *c = ctx;
-    double y[CAL_MF_MAX_Y];
+    double y[CAL_MF_MAX_Y], sd[CAL_MF_MAX_Y];
     cal_mf_predict(c->map, x[0], x[1], y);
     cal_mf_correct(c->correction, c->map->n_y, x[0], x[1], y);
-    return c->p->objective(y, c->p->ctx);
+    for (int k = 0; k < c->map->n_y; ++k)
+        sd[k] = hypot(tier_noise(c->p->run_noise, k), cal_mf_correction_sd(c->correction, k, x[0], x[1]));
+    return c->p->objective(y, sd, c->p->ctx);
 }
 
 void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *correction, const cal_mf_problem *p, double *u,
@@ -159,9 +164,6 @@ void cal_mf_optimum(const cal_mf_map *map, const cal_mf_correction *correction, 
     nlopt_destroy(opt);
     *u = x[0], *v = x[1];
 }
-
-// The expensive runs' noise for measurement k (cal_mf_problem.run_noise; NULL: 0).
-static double tier_noise(const double *run_noise, int k) { return run_noise ? run_noise[k] : 0; }
 
 // The run's noise for measurement k: the problem's, or the run's own where larger.
 static double run_error(const cal_mf_problem *p, const cal_mf_point *run, int k)

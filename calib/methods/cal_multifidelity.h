@@ -98,8 +98,10 @@ double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double 
 /// What the stage gives the loop.
 typedef struct cal_mf_problem {
     int n_y;
-    /// What the search minimises, of a (predicted or measured) measurement vector.
-    double (*objective)(const double *y, void *ctx);
+    /// What the search minimises, of a predicted measurement vector y and, per
+    /// measurement, the sd of what a run there would read: the run noise and
+    /// the kriging's sd of the correction where it stands, in quadrature.
+    double (*objective)(const double *y, const double *sd, void *ctx);
     /// Run the expensive tier at (u, v): run->y filled, and run->sd where a
     /// measurement's own error exceeds run_noise (a mean that is not steady:
     /// it enters the correction weighed by that error, and the run cannot

@@ -512,6 +512,12 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                "not runs of this tier: they enter the identified ranges, never the choice.\n\n",
             predicted, levels ? " and its predicted candidates" : "");
     report_map_span(f, r, b);
+    if (t->angle_aim_sd > 0)
+        fprintf(f, "Each run of the loop was aimed where the corrected map's angle stands %g standard deviation(s) of "
+                   "what a run there would read (this tier's run noise and the kriging's sd of the correction) inside "
+                   "the angle's tolerance, at most at its centre (angle_aim_sd); the choice among the runs is the "
+                   "stage's own rule.\n\n",
+                t->angle_aim_sd);
     if (t->posterior_runs > 0)
         fprintf(f, "After the loop, at most %d more run(s) of this tier where the posterior on the corrected map is "
                    "still held wide by the map's own uncertainty: each at the posterior sample where the kriging's "

@@ -38,6 +38,7 @@ typedef struct two_tier {
     cal_friction_result *r;
     const cal_bounds *bounds;
     const cal_mf_map *map; ///< the cheap map, for the posterior between runs
+    double angle_aim_sd;   ///< the tier's angle_aim_sd (cal_config.h)
 } two_tier;
 
 static int n_measurements(const cal_friction_result *r) { return 1 + r->n_rpm; }
@@ -49,14 +50,25 @@ static void candidate_of(const cal_friction_result *r, const double *y, cal_cand
     cal_candidate_score(r, k);
 }
 
-static double map_objective(const double *y, void *ctx)
+// The penalty starts where the band, narrowed by angle_aim_sd of the
+// prediction's sd (at most to its centre), ends; its scale stays the whole
+// tolerance. Without the narrowing the optimum stands just outside the edge
+// the CSA pulls toward, where the penalty's slope is still small.
+double cal_two_tier_objective(const cal_friction_result *r, const double *y, const double *sd, double angle_aim_sd)
+{
+    cal_candidate k = {0};
+    candidate_of(r, y, &k);
+    if (r->angle_in_misfit) return k.objective;
+    double violation = k.angle_violation;
+    if (angle_aim_sd > 0) violation += fmin(angle_aim_sd * sd[0], r->angle_tolerance);
+    double over = fmax(0, violation) / fmax(r->angle_tolerance, 0.1);
+    return k.misfit + angle_penalty * over * over;
+}
+
+static double map_objective(const double *y, const double *sd, void *ctx)
 {
     const two_tier *t = ctx;
-    cal_candidate k = {0};
-    candidate_of(t->r, y, &k);
-    if (t->r->angle_in_misfit) return k.objective;
-    double over = fmax(0, k.angle_violation) / fmax(t->r->angle_tolerance, 0.1);
-    return k.misfit + angle_penalty * over * over;
+    return cal_two_tier_objective(t->r, y, sd, t->angle_aim_sd);
 }
 
 static int run_here(double u, double v, cal_mf_point *run, void *ctx)
@@ -286,7 +298,7 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
     if (map_stage(env, c, map_tier, angles, areas, k_n, material, gg_mu_s, gg_mu_r, cheap, err, len)) return 1;
     cal_env_set_stage(env, material ? material->name : "granule");
     cal_progress_enter(env->progress, env->stage);
-    two_tier tt = {.r = out};
+    two_tier tt = {.r = out, .angle_aim_sd = t->angle_aim_sd};
     tt.search = cal_friction_begin(env, c, t, angles, areas, k_n, material, gg_mu_s, gg_mu_r, out, err, len);
     if (!tt.search) return 1;
     tt.bounds = cal_friction_bounds(tt.search);

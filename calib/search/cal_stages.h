@@ -257,6 +257,13 @@ int cal_candidate_vector(const cal_friction_result *r, const cal_candidate *k, d
 /// steady one); 1 only if a measurement is missing (every run failed).
 int cal_candidate_run_vector(const cal_friction_result *r, const cal_candidate *k, double *y, double *sd);
 
+/// What the two-tier loop minimises on the corrected map, of a predicted
+/// measurement vector y (angle, then CSA per speed) whose run would read each
+/// within sd: the stage's objective under angle_rule misfit; otherwise the
+/// CSA misfit plus a penalty on the angle outside its tolerance band,
+/// narrowed by angle_aim_sd × sd[0] (at most to its centre; the tier's key).
+double cal_two_tier_objective(const cal_friction_result *r, const double *y, const double *sd, double angle_aim_sd);
+
 /// The same stage across two tiers (the tier's map_tier maps, the tier itself
 /// decides; cal_multifidelity.h): the cheap tier's whole search first (its
 /// candidates in cheap_out), then the tier's own runs where the corrected map

@@ -112,6 +112,13 @@ back=$(edit return_many 's/return_runs: 1$/return_runs: 17/')
 expect "return runs out of range" "return_many.yaml:$(line_of "$back" 'return_runs: 17'): return_runs: 17 must be in [0, 16]" -- "$back" "${out[@]}"
 back=$(edit return_alone '/posterior_runs: 2$/d')
 expect "return runs without posterior runs" "return_alone.yaml:$(line_of "$back" 'return_runs: 1$'): return_runs: only a tier with posterior_runs" -- "$back" "${out[@]}"
+# angle_aim_sd: standard deviations in [0, 3], and only on a tier whose runs a corrected map aims.
+aim=$(edit aim_many 's/return_runs: 1$/return_runs: 1\n    angle_aim_sd: 4/')
+expect "angle aim out of range" "aim_many.yaml:$(line_of "$aim" 'angle_aim_sd: 4'): angle_aim_sd: 4 must be in [0, 3] standard deviations" -- "$aim" "${out[@]}"
+aim=$(edit aim_alone '/- name: check$/a\    angle_aim_sd: 1')
+expect "angle aim without a map" "aim_alone.yaml:$(line_of "$aim" 'angle_aim_sd: 1'): angle_aim_sd: only a tier with a map_tier" -- "$aim" "${out[@]}"
+aim=$(edit aim_misfit 's/return_runs: 1$/return_runs: 1\n    angle_rule: misfit\n    angle_aim_sd: 1/')
+expect "angle aim under the misfit rule" "aim_misfit.yaml:$(line_of "$aim" 'angle_aim_sd: 1'): angle_aim_sd: angle_rule misfit weighs the angle in the misfit" -- "$aim" "${out[@]}"
 # granucal synthesize (twin data): pairs and beds checked before the first run.
 walls=(--wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 --wall PTFE=0.9,1e-4)
 cmd=synthesize expect "twin: a material without its pair" "no --wall PTFE=MU_S,MU_R" -- "$work/configs/good.yaml" --wall aluminium=0.8,0.2 --wall PP=0.9,1e-4 "${out[@]}"

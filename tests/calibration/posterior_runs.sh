@@ -10,7 +10,10 @@
 #  - report.md says how many were made and why they stopped, as the log does;
 #  - the same command again runs nothing and writes the same table (the posterior is deterministic);
 #  - with return_runs: 0 the stage re-derives from the same store with 0 simulations, without the
-#    returned runs; with posterior_runs: 0 as well, the loop's runs alone, and no word of runs after it.
+#    returned runs; with posterior_runs: 0 as well, the loop's runs alone, and no word of runs after it;
+#  - with angle_aim_sd: 1 (from a copy of the store) the loop's first run is aimed no farther from the
+#    angle's target than without it (a penalty that grows with the distance cannot push the optimum
+#    away), and report.md says how the runs were aimed.
 #   usage: posterior_runs.sh GRANUCAL SOURCE_DIR WORK_DIR
 set -euo pipefail
 bin=$1 src=$2 work=$3
@@ -29,7 +32,9 @@ sed -e 's/^    return_runs: 1$/    return_runs: 0/' -e "s|\.\./experiments/|$src
 # (every tier's: a return_runs without posterior_runs is refused)
 sed -e 's/^    posterior_runs: 2$/    posterior_runs: 0/' -e 's/^    return_runs: [0-9]*$/    return_runs: 0/' \
   "$work/no_return.yaml" > "$work/none.yaml"
-for v in no_return none; do
+sed -e 's/^    return_runs: 1$/    return_runs: 1\n    angle_aim_sd: 1/' -e "s|\.\./experiments/|$src/experiments/|" \
+  configs/calibration.yaml > "$work/aim.yaml"
+for v in no_return none aim; do
   mkdir -p "$work/$v" && cp -r "$work/out/store" "$work/$v/"
   run $v "$work/$v.yaml" "$work/$v"
 done
@@ -93,5 +98,15 @@ none = open(f"{work}/none.log").read()
 check(" 0 simulations run now" in none, "posterior_runs: 0 re-derives from the same store with 0 simulations")
 check(len(deciding_pairs(f"{work}/none")) == loop_runs, f"posterior_runs: 0 keeps the loop's {loop_runs} runs alone")
 check("After the loop" not in open(f"{work}/none/report.md").read(), "posterior_runs: 0: no word of runs after the loop")
+
+def first_aim(log):
+    m = re.search(r"^-- run 1 at tier 'check-posterior': angle \S+ measured.*?, (\S+)° predicted", log, re.M)
+    return float(m.group(1)) if m else None
+target = float(re.search(r"target (\S+) ±", log).group(1))
+plain, aimed = first_aim(log), first_aim(open(f"{work}/aim.log").read())
+check(plain is not None and aimed is not None and abs(aimed - target) <= abs(plain - target) + 0.01,
+      f"angle_aim_sd 1: the first run aimed at {aimed}°, no farther from the target {target}° than without it ({plain}°)")
+check("inside the angle's tolerance, at most at its centre (angle_aim_sd)" in open(f"{work}/aim/report.md").read(),
+      "angle_aim_sd 1: report.md says how the loop's runs were aimed")
 finish()
 PY

@@ -44,9 +44,9 @@ static void cheap_response(const twin *t, double u, double v, double *y)
     y[0] += t->bias_slope_u * u + t->bias_curve_v * (v - 0.5) * (v - 0.5);
 }
 
-static double objective(const double *y, void *ctx)
+static double objective(const double *y, const double *sd, void *ctx)
 {
-    (void)ctx;
+    (void)sd, (void)ctx;
     double sum = 0;
     for (int k = 0; k < N_Y; ++k) sum += (y[k] - target[k]) * (y[k] - target[k]) / (spread[k] * spread[k]);
     return sum / N_Y;
@@ -190,7 +190,7 @@ static void a_varying_bias_converges_within_noise(void **state)
     expensive_response(r.run[r.n - 1].u, r.run[r.n - 1].v, got);
     // Within one unit of the objective (one standard deviation in the mean
     // squared z-score) of the best the expensive tier can do.
-    assert_true(objective(got, NULL) - objective(best, NULL) < 1.0);
+    assert_true(objective(got, NULL, NULL) - objective(best, NULL, NULL) < 1.0);
 }
 
 // A bias that varies along v (log μr), as λ 4096 against the ci map did
@@ -221,7 +221,7 @@ static void a_bias_along_mu_r_is_fitted(void **state)
         double got[N_Y];
         expensive_response(lu, lv, got);
         if (kind) assert_true(fabs(lu - u) < 0.01 && fabs(lv - v) < 0.01);
-        else assert_true(objective(got, NULL) - objective(best, NULL) < 1.0);
+        else assert_true(objective(got, NULL, NULL) - objective(best, NULL, NULL) < 1.0);
     }
 }
 
@@ -238,9 +238,9 @@ static void a_bias_along_mu_r_is_fitted(void **state)
 // same runs leave off, must not: the test shows the difference, not just one.
 static void bound_expensive(double u, double v, double *y) { y[0] = 20 + 4 * u + 22 * v * v, y[1] = 45 + 2 * u; }
 static void bound_cheap(double u, double v, double *y) { y[0] = 26 + 4 * u + 8 * v, y[1] = 45 + 2 * u; }
-static double bound_objective(const double *y, void *ctx)
+static double bound_objective(const double *y, const double *sd, void *ctx)
 {
-    (void)ctx;
+    (void)sd, (void)ctx;
     return (y[0] - 34.6) * (y[0] - 34.6) / 0.25 + (y[1] - 48.0) * (y[1] - 48.0);
 }
 static int bound_run(double u, double v, cal_mf_point *run, void *ctx)
