@@ -523,7 +523,7 @@ static void report_two_tier(FILE *f, const cal_friction_result *r, const cal_tie
                    "still held wide by the map's own uncertainty: each at the posterior sample where the kriging's "
                    "variance is the largest share of a measurement's whole variance, and none once that share, "
                    "averaged over the posterior, is below %.0f %% for every measurement that moves with a parameter "
-                   "the data can tell (there the width is the data's own, and runs cannot narrow it). Made: %d; %s; "
+                   "the data can tell (there the width is the data's and the map's residual, which runs cannot narrow). Made: %d; %s; "
                    "the last share seen: %.0f %% (%s).\n\n",
                 t->posterior_runs, 100 * CAL_POSTERIOR_MAP_SHARE, r->posterior_runs,
                 r->posterior_runs_outcome ? r->posterior_runs_outcome : "not run", 100 * r->posterior_share,
@@ -599,6 +599,18 @@ static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bo
     for (int k = 0; k < p->n_y; ++k)
         fprintf(f, "| %s | %.3g | %+.2f | %+.2f |\n", p->observable[k], p->data_sd[k], p->sensitivity[k][0],
                 p->sensitivity[k][1]);
+    fputs("\nWhat each measurement's spread in the posterior is made of (in quadrature): the data's, the map's rms "
+          "residual (the same over the whole plane; runs at this tier do not shrink it) and the kriging's sd of the "
+          "correction at the posterior median:\n\n"
+          "| measurement | data | map's residual | kriging | in all |\n|---|---|---|---|---|\n", f);
+    for (int k = 0; k < p->n_y; ++k)
+        fprintf(f, "| %s | %.3g | %.3g | %.3g | %.3g |\n", p->observable[k], p->data_sd[k], p->map_rms[k],
+                p->kriging_sd[k], sqrt(p->data_sd[k] * p->data_sd[k] + p->map_rms[k] * p->map_rms[k] +
+                                       p->kriging_sd[k] * p->kriging_sd[k]));
+    if (cal_posterior_map_bound(p))
+        fputs("\n**The map's residual, not the data, sets this posterior's width**: for a measurement that tells a "
+              "parameter, the map tier's fit misses its own candidates by more than the data's spread. More runs at "
+              "this tier do not narrow that; a map that fits better would.\n", f);
     double lo[2] = {b->mu_s_min, b->mu_r_min}, hi[2] = {b->mu_s_max, b->mu_r_max};
     for (int k = 0; k < 2; ++k)
         if (cal_posterior_blind(p, k))

@@ -200,6 +200,8 @@ int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_
     double um, vm;
     cal_friction_to_unit(b, out->median[0], out->median[1], &um, &vm);
     sensitivities(&m, um, vm, out);
+    for (int k = 0; k < m.map.n_y; ++k)
+        out->map_rms[k] = m.map.rms[k], out->kriging_sd[k] = cal_mf_correction_sd(m.correction, k, um, vm);
     free(su), free(sv);
     return 0;
 }
@@ -217,6 +219,13 @@ static int tells(const cal_posterior *p, int k)
 {
     for (int q = 0; q < 2; ++q)
         if (!cal_posterior_blind(p, q) && fabs(p->sensitivity[k][q]) >= 1) return 1;
+    return 0;
+}
+
+int cal_posterior_map_bound(const cal_posterior *p)
+{
+    for (int k = 0; k < p->n_y; ++k)
+        if (tells(p, k) && p->map_rms[k] > p->data_sd[k]) return 1;
     return 0;
 }
 

@@ -45,7 +45,18 @@ typedef struct cal_posterior {
     /// whole search range (the other at its median), in the data's spreads:
     /// |value| < 1 means that measurement cannot tell that parameter at all.
     double sensitivity[CAL_MF_MAX_Y][2];
+    /// What each measurement's spread in the likelihood is made of besides
+    /// data_sd: the map's rms residual (the same everywhere; runs at this
+    /// tier do not shrink it) and the kriging's sd at the posterior median (0
+    /// for a one-tier map).
+    double map_rms[CAL_MF_MAX_Y], kriging_sd[CAL_MF_MAX_Y];
 } cal_posterior;
+
+/// Whether the map's residual, not the data's spread, is the larger part of
+/// a measurement's spread for some measurement that moves by a data spread
+/// across a parameter the data can tell: then the posterior is as wide as
+/// the map tier's own fit, and runs at this tier cannot narrow it.
+int cal_posterior_map_bound(const cal_posterior *p);
 
 /// Sample the posterior of stage r (bounds b). 0 on success; 1 with a
 /// message (and out->n = 0) when there is no map to sample (fewer than three

@@ -254,10 +254,11 @@ static int posterior_next(const cal_mf_correction *c, double *u, double *v, void
     else if (none && need.measurement < 0)
         fprintf(stderr, "-- posterior: no measurement moves by one data spread with a parameter the data can tell: "
                         "no run would narrow it; no more runs\n");
-    else if (none)
+    else if (none) // the rest is the data's spread and the map's residual, which runs here do not shrink
         fprintf(stderr, "-- posterior: the map's own uncertainty is %.0f %% of the variance of %s (below %.0f %%): "
-                        "the width is the data's; no more runs\n", 100 * need.share, r->posterior_share_of,
-                100 * CAL_POSTERIOR_MAP_SHARE);
+                        "the width is the data's (sd %.3g) and the map's residual (rms %.3g), which runs at this tier "
+                        "do not narrow; no more runs\n", 100 * need.share, r->posterior_share_of,
+                100 * CAL_POSTERIOR_MAP_SHARE, post.data_sd[need.measurement], post.map_rms[need.measurement]);
     else {
         double mu_s, mu_r;
         cal_friction_to_mu(t->bounds, *u, *v, &mu_s, &mu_r);

@@ -52,7 +52,9 @@ def sensitivities(report):
         table = section.split("What each measurement can tell", 1)
         if len(table) < 2:
             continue
-        rows = re.findall(r"^\| [^|]+ \| [^|]+ \| ([-+]?[\d.]+) \| ([-+]?[\d.]+) \|$", table[1], re.M)
+        # the table right after that heading, up to the blank line that ends it
+        body = table[1].split("\n\n")[1] if "\n\n" in table[1] else ""
+        rows = re.findall(r"^\| [^|]+ \| [^|]+ \| ([-+]?[\d.]+) \| ([-+]?[\d.]+) \|$", body, re.M)
         if rows:
             out[stage] = {"mu_s": max(abs(float(a)) for a, _ in rows), "mu_r": max(abs(float(b)) for _, b in rows)}
     return out
