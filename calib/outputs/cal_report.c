@@ -605,8 +605,7 @@ static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bo
           "| measurement | data | map's residual | kriging | in all |\n|---|---|---|---|---|\n", f);
     for (int k = 0; k < p->n_y; ++k)
         fprintf(f, "| %s | %.3g | %.3g | %.3g | %.3g |\n", p->observable[k], p->data_sd[k], p->map_rms[k],
-                p->kriging_sd[k], sqrt(p->data_sd[k] * p->data_sd[k] + p->map_rms[k] * p->map_rms[k] +
-                                       p->kriging_sd[k] * p->kriging_sd[k]));
+                p->kriging_sd[k], p->spread[k]);
     if (cal_posterior_map_bound(p))
         fputs("\n**The map's residual, not the data, sets this posterior's width**: for a measurement that tells a "
               "parameter, the map tier's fit misses its own candidates by more than the data's spread. More runs at "

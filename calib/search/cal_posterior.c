@@ -200,6 +200,8 @@ int cal_posterior_sample(const cal_friction_result *r, const cal_bounds *b, cal_
     double um, vm;
     cal_friction_to_unit(b, out->median[0], out->median[1], &um, &vm);
     sensitivities(&m, um, vm, out);
+    double y[CAL_MF_MAX_Y];
+    predict(&m, um, vm, y, out->spread);
     for (int k = 0; k < m.map.n_y; ++k)
         out->map_rms[k] = m.map.rms[k], out->kriging_sd[k] = cal_mf_correction_sd(m.correction, k, um, vm);
     free(su), free(sv);

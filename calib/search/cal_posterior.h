@@ -48,8 +48,9 @@ typedef struct cal_posterior {
     /// What each measurement's spread in the likelihood is made of besides
     /// data_sd: the map's rms residual (the same everywhere; runs at this
     /// tier do not shrink it) and the kriging's sd at the posterior median (0
-    /// for a one-tier map).
-    double map_rms[CAL_MF_MAX_Y], kriging_sd[CAL_MF_MAX_Y];
+    /// for a one-tier map); spread: the three in quadrature there, as the
+    /// likelihood counts them.
+    double map_rms[CAL_MF_MAX_Y], kriging_sd[CAL_MF_MAX_Y], spread[CAL_MF_MAX_Y];
 } cal_posterior;
 
 /// Whether the map's residual, not the data's spread, is the larger part of
