@@ -133,6 +133,7 @@ static double corrected_objective(unsigned n, const double *x, double *grad, voi
     double y[CAL_MF_MAX_Y], sd[CAL_MF_MAX_Y];
     cal_mf_predict(c->map, x[0], x[1], y);
     cal_mf_correct(c->correction, c->map->n_y, x[0], x[1], y);
+    if (!c->p->objective_uses_sd) return c->p->objective(y, NULL, c->p->ctx);
     for (int k = 0; k < c->map->n_y; ++k)
         sd[k] = hypot(tier_noise(c->p->run_noise, k), cal_mf_correction_sd(c->correction, k, x[0], x[1]));
     return c->p->objective(y, sd, c->p->ctx);

@@ -102,6 +102,9 @@ typedef struct cal_mf_problem {
     /// measurement, the sd of what a run there would read: the run noise and
     /// the kriging's sd of the correction where it stands, in quadrature.
     double (*objective)(const double *y, const double *sd, void *ctx);
+    /// Whether the objective reads sd; 0: it is handed NULL, and the kriging's
+    /// variance (a Cholesky solve per measurement) is not computed for it.
+    int objective_uses_sd;
     /// Run the expensive tier at (u, v): run->y filled, and run->sd where a
     /// measurement's own error exceeds run_noise (a mean that is not steady:
     /// it enters the correction weighed by that error, and the run cannot

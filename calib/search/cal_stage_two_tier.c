@@ -318,7 +318,8 @@ int cal_stage_two_tier(cal_env *env, const cal_config *c, const cal_tier *t, con
         return cal_friction_finish(tt.search) || exp_fail(err, len, "%s: %s (tier '%s')", env->stage, out->two_tier_outcome,
                                                           map_tier->name);
     }
-    cal_mf_problem p = {.n_y = n_y, .objective = map_objective, .run_expensive = run_here, .noise = noise, .run_noise = run_noise,
+    cal_mf_problem p = {.n_y = n_y, .objective = map_objective, .objective_uses_sd = t->angle_aim_sd > 0,
+                        .run_expensive = run_here, .noise = noise, .run_noise = run_noise,
                         .max_expensive = t->max_evaluations, .ctx = &tt, .correction = cal_tier_map_correction(t)};
     out->map_correction = cal_mf_correction_name(p.correction);
     fprintf(stderr, "-- tier '%s' where the corrected map puts the optimum (at most %d runs; correction: %s)\n", t->name,

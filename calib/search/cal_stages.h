@@ -262,6 +262,7 @@ int cal_candidate_run_vector(const cal_friction_result *r, const cal_candidate *
 /// within sd: the stage's objective under angle_rule misfit; otherwise the
 /// CSA misfit plus a penalty on the angle outside its tolerance band,
 /// narrowed by angle_aim_sd × sd[0] (at most to its centre; the tier's key).
+/// sd is read only where angle_aim_sd > 0 outside the misfit rule (may be NULL otherwise).
 double cal_two_tier_objective(const cal_friction_result *r, const double *y, const double *sd, double angle_aim_sd);
 
 /// The same stage across two tiers (the tier's map_tier maps, the tier itself

@@ -69,7 +69,7 @@ static double angle_aimed_at(double z)
     cal_mf_map map = linear_map();
     double noise[N_Y] = {tolerance, 1}, run_noise[N_Y] = {run_angle_sd, 0.5};
     aim a = {r, z};
-    cal_mf_problem p = {.n_y = N_Y, .objective = aimed, .noise = noise, .run_noise = run_noise, .ctx = &a};
+    cal_mf_problem p = {.n_y = N_Y, .objective = aimed, .objective_uses_sd = 1, .noise = noise, .run_noise = run_noise, .ctx = &a};
     double u, v, y[N_Y];
     cal_mf_optimum(&map, NULL, &p, &u, &v);
     cal_mf_predict(&map, u, v, y);
@@ -142,7 +142,7 @@ static void test_the_objective_gets_the_run_noise_and_the_kriging_sd(void **stat
     for (int k = 0; k < N_Y; ++k) c.scale[k] = 1.5, c.nugget[k][0] = c.nugget[k][1] = 0.01; // weights 0: y unmoved
     double noise[N_Y] = {1, 1}, run_noise[N_Y] = {0.25, 0.5};
     witness w = {&c, run_noise, 0, 0};
-    cal_mf_problem p = {.n_y = N_Y, .objective = check_sd, .noise = noise, .run_noise = run_noise, .ctx = &w};
+    cal_mf_problem p = {.n_y = N_Y, .objective = check_sd, .objective_uses_sd = 1, .noise = noise, .run_noise = run_noise, .ctx = &w};
     double u, v;
     cal_mf_optimum(&map, &c, &p, &u, &v);
     assert_true(w.calls > 41 * 41);
