@@ -79,6 +79,7 @@ struct dem_world {
     double hist_dt; // dt when positions moved since the last force evaluation, else 0
     int moved;
     uint64_t step;
+    uint64_t particle_steps; // Σ granules over the steps taken (dem_world_particle_steps)
     // The step's own network checks (def.network_check_interval, dem_step.c):
     // the steps since the last one, on which the next is scheduled (a resumed
     // run checks where the run that wrote the checkpoint would have), and

@@ -644,11 +644,13 @@ dem_status dem_world_step(dem_world *w, uint64_t steps)
     size_t bad0 = first_nonfinite(w);
     if (bad0 != SIZE_MAX) return fault(w, DEM_ERR_NONFINITE, bad0, "non-finite state (NaN or infinity)");
     st = ensure_forces(w);
+    const uint64_t step0 = w->step; // the clock counts the steps taken, also those of a run that faults
     for (uint64_t done = 0; st == DEM_OK && done < steps;) {
         const uint64_t run = steps_before_check(w, steps - done);
         st = step_run(w, run);
         done += run;
         if (st == DEM_OK) st = count_steps(w, run);
     }
+    w->particle_steps += (w->step - step0) * (uint64_t)w->n;
     return st;
 }

@@ -437,6 +437,7 @@ dem_granules_view dem_world_granules(const dem_world *w)
 }
 
 double dem_world_time(const dem_world *w) { return w->time; }
+uint64_t dem_world_particle_steps(const dem_world *w) { return w->particle_steps; }
 double dem_world_dt(const dem_world *w) { return w->dt; }
 double dem_world_dt_limit(const dem_world *w) { return w->dt_limit; }
 int dem_world_implicit_springs(const dem_world *w) { return w->implicit_springs; }

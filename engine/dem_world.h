@@ -324,6 +324,10 @@ dem_diagnostics dem_world_diagnose(const dem_world *w);
 /// into `counts` (granule count entries); the rule dem_world_diagnose counts by.
 void dem_world_contact_counts(const dem_world *w, unsigned *counts);
 double dem_world_time(const dem_world *w);
+/// Granule-steps taken so far (each step counts the granules it moved), the
+/// cost figure benchmarks divide by wall time. A clone carries its source's
+/// count; a world read from a checkpoint starts again at 0.
+uint64_t dem_world_particle_steps(const dem_world *w);
 double dem_world_dt(const dem_world *w);
 /// The stability limit found by dem_world_prepare (s); 0 before it.
 double dem_world_dt_limit(const dem_world *w);

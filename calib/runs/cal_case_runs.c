@@ -936,7 +936,7 @@ static int pour_one(int i, void *ctx)
     r.coordination = res.coordination, r.coordination_interior = res.coordination_interior;
     r.wall_contacts_per_granule = res.wall_contacts_per_granule, r.solid_fraction = res.solid_fraction;
     r.steady = 1, r.simulated_time_s = res.simulated_time_s, r.wall_time_s = exp_wall_seconds() - t0;
-    r.peak_rss_mb = exp_peak_rss_mb();
+    r.peak_rss_mb = exp_peak_rss_mb(), r.particle_steps = res.particle_steps;
     r.dt_s = dem_world_dt(w), r.granules = (int)res.granules;
     dem_world_destroy(w);
     int bad = cal_store_put(b->env->store, &r, err, sizeof err);

@@ -151,5 +151,6 @@ dem_world *exp_cylinder_run(const exp_cylinder_def *d, exp_progress_fn progress,
     }
     out->solid_fraction = solid / (DEM_PI * r * r * d->depth);
     out->simulated_time_s = dem_world_time(w);
+    out->particle_steps = (double)dem_world_particle_steps(w);
     return w;
 }

@@ -39,6 +39,7 @@ typedef struct exp_cylinder_result {
     double wall_contacts_per_granule; ///< granule–wall contacts per granule, stated separately
     double solid_fraction;        ///< solid volume over the bed's volume (the cylinder's: the container below the rim)
     double simulated_time_s;
+    double particle_steps; ///< granule-steps of the pour and settling (dem_world_particle_steps)
 } exp_cylinder_result;
 
 /// What a poured cylinder is expected to cost, before it runs (for the

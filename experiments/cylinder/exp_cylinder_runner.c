@@ -20,15 +20,11 @@
 typedef struct progress_state {
     int verbose;
     double last_print, start;
-    double last_t, granule_seconds; ///< Σ granules × simulated time, for the particle-step estimate
 } progress_state;
 
 static void on_progress(const char *phase, double t, size_t granules, void *ctx)
 {
     progress_state *p = ctx;
-    // exp_run_for reports after each chunk of steps, with the granules the chunk ran.
-    if (t > p->last_t) p->granule_seconds += (t - p->last_t) * (double)granules;
-    p->last_t = t;
     if (!p->verbose) return;
     double now = exp_wall_seconds();
     if (now - p->last_print < 10.0) return;
@@ -40,14 +36,13 @@ dem_world *exp_cylinder_pour_and_report(const exp_cylinder_def *d, int verbose, 
                                         exp_cylinder_report *rep, char *err, size_t len)
 {
     memset(rep, 0, sizeof *rep);
-    progress_state p = {verbose, 0, exp_wall_seconds(), 0, 0};
+    progress_state p = {verbose, 0, exp_wall_seconds()};
     p.last_print = p.start;
     dem_world *w = exp_cylinder_run(d, on_progress, &p, r, err, len);
     rep->wall_time_s = exp_wall_seconds() - p.start;
     if (!w) return NULL;
     dem_gsd gsd = dem_scale_gsd(&d->gsd, d->lambda);
     rep->ke_ratio = exp_ke_ratio(w, gsd.median_diameter);
-    rep->particle_steps_est = dem_world_dt(w) > 0 ? p.granule_seconds / dem_world_dt(w) : 0;
     rep->bed_surface_m = exp_bed_surface(w, 0);
     dem_granules_view g = dem_world_granules(w);
     for (size_t i = 0; i < g.count; ++i) rep->bed_top_m = fmax(rep->bed_top_m, g.position[i].y + g.radius[i]);
@@ -82,9 +77,9 @@ void exp_cylinder_write_json(FILE *f, const exp_cylinder_def *d, const exp_cylin
     json_number(f, "bed_top_m", rep->bed_top_m, "%.5g");
     json_number(f, "ke_ratio", rep->ke_ratio, "%.3g");
     fprintf(f,
-            ", \"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"particle_steps_est\": %.0f, \"dt_s\": %.6g, "
+            ", \"simulated_time_s\": %.4f, \"wall_time_s\": %.2f, \"particle_steps\": %.0f, \"dt_s\": %.6g, "
             "\"effects\": \"%s\"}\n",
-            r->simulated_time_s, rep->wall_time_s, rep->particle_steps_est, dem_world_dt(w), effects);
+            r->simulated_time_s, rep->wall_time_s, r->particle_steps, dem_world_dt(w), effects);
 }
 
 // result.json's writer (exp_result_json_fn) over exp_cylinder_write_json.

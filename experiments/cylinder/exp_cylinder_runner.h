@@ -13,7 +13,6 @@
 typedef struct exp_cylinder_report {
     double wall_time_s;
     double ke_ratio;            ///< kinetic energy over (bed mass)·g·d50 at the end (at rest: < 1e-6)
-    double particle_steps_est;  ///< Σ granules × simulated time / the final step (the step may change while pouring)
     double bed_surface_m;       ///< height below which 98 % of the granule tops lie
     double bed_top_m;           ///< highest granule top
 } exp_cylinder_report;

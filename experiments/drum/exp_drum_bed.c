@@ -32,5 +32,6 @@ dem_world *exp_drum_bed_run(const exp_drum_def *d, exp_progress_fn progress, voi
     }
     out->solid_fraction = solid / (d->fill * DEM_PI * r * r * d->depth);
     out->simulated_time_s = dem_world_time(w);
+    out->particle_steps = (double)dem_world_particle_steps(w);
     return w;
 }

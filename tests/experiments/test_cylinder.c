@@ -204,6 +204,9 @@ static void test_shipped_scene_at_rest(void **state)
     assert_non_null(strstr(json, want));
     snprintf(want, sizeof want, "\"wall_contacts_per_granule\": %.4f,", r.wall_contacts_per_granule);
     assert_non_null(strstr(json, want));
+    assert_true(r.particle_steps >= (double)r.granules); // the engine's own count: at least one step of the bed
+    snprintf(want, sizeof want, "\"particle_steps\": %.0f,", r.particle_steps);
+    assert_non_null(strstr(json, want));
     const char *keys[] = {"\"experiment\": \"cylinder\"", "\"status\": ", "\"k_n\": 200,", "\"mu_s\": 0.5,",
                           "\"mu_r\": 0.1,", "\"lambda\": 262144,", "\"seed\": 1,", "\"coordination_interior\": ",
                           "\"solid_fraction\": ", "\"simulated_time_s\": ", "\"wall_time_s\": ", "\"dt_s\": ",

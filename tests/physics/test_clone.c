@@ -62,8 +62,33 @@ static void test_clone_steps_identically(void **state)
     dem_world_destroy(c);
 }
 
+// The cost figure: each step counts the granules it moved (200 for 300
+// steps, then 201 for 40), a clone starts from its source's count, and the
+// count moves with neither the other's steps.
+static void test_particle_steps_counted(void **state)
+{
+    (void)state;
+    dem_world *w = small_bed();
+    assert_true(dem_world_particle_steps(w) == 0);
+    assert_int_equal(dem_world_step(w, 300), DEM_OK);
+    assert_true(dem_world_particle_steps(w) == 300u * 200u);
+    dem_world_add_granule(w, dem_v3(0, 0.1, 0), dem_v3(0, 0, 0), dem_v3(0, 0, 0), 1e-3, 1800);
+    assert_int_equal(dem_world_step(w, 40), DEM_OK);
+    const uint64_t counted = 300u * 200u + 40u * 201u;
+    assert_true(dem_world_particle_steps(w) == counted);
+    dem_world *c = dem_world_clone(w);
+    assert_non_null(c);
+    assert_true(dem_world_particle_steps(c) == counted);
+    assert_int_equal(dem_world_step(c, 10), DEM_OK);
+    assert_true(dem_world_particle_steps(c) == counted + 10u * 201u);
+    assert_true(dem_world_particle_steps(w) == counted);
+    dem_world_destroy(c);
+    dem_world_destroy(w);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_clone_steps_identically)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_clone_steps_identically),
+                                       cmocka_unit_test(test_particle_steps_counted)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
