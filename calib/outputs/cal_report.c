@@ -414,6 +414,23 @@ static void report_range(FILE *f, const char *name, cal_range g, double lo_bound
     fputs(".\n", f);
 }
 
+// The not-excluded intervals read along the other parameter (cal_friction_range_along), beside the stage's.
+static void report_along(FILE *f, const cal_friction_result *r, const cal_bounds *b)
+{
+    const char *name[2] = {"μs", "μr"};
+    const cal_range *own[2] = {&r->mu_s_range, &r->mu_r_range};
+    fputs("- Read along the other friction (an excluded candidate brackets only where its other friction lies inside "
+          "that one's identified range, as a profile over it would; no status reads this):",
+          f);
+    for (int p = 0; p < 2; ++p) {
+        cal_range g = cal_friction_range_along(r, p, b);
+        fprintf(f, "%s %s not excluded %.3g – %.3g", p ? ";" : "", name[p], g.bracket_lo, g.bracket_hi);
+        if (g.bracket_lo == own[p]->bracket_lo && g.bracket_hi == own[p]->bracket_hi) fputs(" (the same)", f);
+        else fprintf(f, " (the stage's interval: %.3g – %.3g)", own[p]->bracket_lo, own[p]->bracket_hi);
+    }
+    fputs(".\n", f);
+}
+
 static void report_identified(FILE *f, const cal_friction_result *r, const cal_bounds *b)
 {
     int tier_sd = 0;
@@ -440,6 +457,7 @@ static void report_identified(FILE *f, const cal_friction_result *r, const cal_b
     if (!isfinite(r->mu_s_range.lo)) return;
     report_range(f, "μs", r->mu_s_range, b->mu_s_min, b->mu_s_max);
     report_range(f, "μr", r->mu_r_range, b->mu_r_min, b->mu_r_max);
+    report_along(f, r, b);
 }
 
 // One level's row: its tier, what it ran and cost, what its own search chose, how it ended.

@@ -368,19 +368,22 @@ static double chi2_of(const cal_friction_result *r, const cal_candidate *k)
 }
 
 // μs (rolling = 0) or μr over the identified candidates, and the nearest
-// excluded value beyond each end.
-static cal_range range_of(const cal_friction_result *r, int rolling)
+// excluded value beyond each end; with `along`, only of excluded candidates
+// whose other parameter lies inside the identified range of that other one.
+static cal_range range_of(const cal_friction_result *r, int rolling, int along)
 {
     cal_range g = {INFINITY, -INFINITY, NAN, NAN, NAN, NAN};
+    double other_lo = INFINITY, other_hi = -INFINITY;
     for (int i = 0; i < r->n; ++i)
         if (r->cand[i].identified) {
-            double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
+            double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s, o = rolling ? r->cand[i].mu_s : r->cand[i].mu_r;
             g.lo = fmin(g.lo, v), g.hi = fmax(g.hi, v);
+            other_lo = fmin(other_lo, o), other_hi = fmax(other_hi, o);
         }
     if (!(g.lo <= g.hi)) return CAL_NO_RANGE;
     for (int i = 0; i < r->n; ++i) {
-        double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s;
-        if (r->cand[i].identified) continue;
+        double v = rolling ? r->cand[i].mu_r : r->cand[i].mu_s, o = rolling ? r->cand[i].mu_s : r->cand[i].mu_r;
+        if (r->cand[i].identified || (along && !(o >= other_lo && o <= other_hi))) continue;
         if (v < g.lo && !(v <= g.below)) g.below = v; // the largest value below
         if (v > g.hi && !(v >= g.above)) g.above = v; // the smallest above
     }
@@ -411,7 +414,14 @@ void cal_friction_identify(cal_friction_result *r)
         r->cand[i].identified = r->cand[i].chi2 - r->chi2_least <= r->chi2_threshold;
         r->identified_count += r->cand[i].identified;
     }
-    r->mu_s_range = range_of(r, 0), r->mu_r_range = range_of(r, 1);
+    r->mu_s_range = range_of(r, 0, 0), r->mu_r_range = range_of(r, 1, 0);
+}
+
+cal_range cal_friction_range_along(const cal_friction_result *r, int rolling, const cal_bounds *b)
+{
+    cal_range g = range_of(r, rolling, 1);
+    cal_range_bracket(&g, rolling ? b->mu_r_min : b->mu_s_min, rolling ? b->mu_r_max : b->mu_s_max);
+    return g;
 }
 
 static const char *run_cobyla(search *s)

@@ -193,6 +193,16 @@ int cal_friction_best(const cal_friction_result *r);
 /// tell from the best; μs and μr range over those. Needs csa_tier_sd set.
 void cal_friction_identify(cal_friction_result *r);
 
+/// The not-excluded interval of μs (rolling = 0) or μr read along the other
+/// parameter: bracketed only by excluded candidates whose other parameter lies
+/// inside the identified range of that other one (the search bound where none
+/// does). The stage's own interval (mu_s_range) lets any excluded pair
+/// bracket, so a pair excluded at another μr closes μs; on a grid whose
+/// columns share their μr values the two agree, on a two-tier stage's few
+/// scattered runs they need not (docs/calibration.md). Reported beside the
+/// stage's interval; no status reads it.
+cal_range cal_friction_range_along(const cal_friction_result *r, int rolling, const cal_bounds *b);
+
 /// The drum runs stage 2 (material == NULL) or 3 may take at tier t at most:
 /// its speeds times beds times (grid points + COBYLA's evaluations + bound
 /// probes), or with a map tier times its max_evaluations (the map tier's

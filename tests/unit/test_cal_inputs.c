@@ -687,6 +687,39 @@ static void test_identified_ranges(void **state)
     assert_true(r.cand[2].identified && r.cand[3].identified && r.cand[4].identified);
     assert_true(r.mu_s_range.lo == 0.775 && r.mu_s_range.hi == 1 && r.mu_s_range.below == 0.325);
     assert_true(r.mu_r_range.lo == 0.000149535 && r.mu_r_range.hi == 0.033437);
+    // On this grid, read along the other friction, μs is bracketed as before: both excluded
+    // candidates at μs 0.325 stand at μr values inside the identified μr range.
+    cal_bounds b = {.mu_s_min = 0.1, .mu_s_max = 1, .mu_r_min = 1e-5, .mu_r_max = 0.5};
+    cal_range along = cal_friction_range_along(&r, 0, &b);
+    assert_true(along.bracket_lo == 0.325 && along.bracket_hi == 1);
+}
+
+// The not-excluded interval read along the other friction (cal_friction_range_along), on
+// scattered runs as a two-tier stage makes them: A (0.9, 0.2) fits; B (0.8, 0.05) and C (0.95,
+// 0.2) are told apart. The stage's interval lets B close μs at 0.8 though B stands at another
+// μr; along μr 0.2 only C brackets (above), so μs runs to the bound below. μr: no excluded
+// candidate stands at μs 0.9, so both ends go to the bounds (the stage's: B's 0.05 below).
+static void test_range_along_the_other_friction(void **state)
+{
+    (void)state;
+    static cal_friction_result r;
+    memset(&r, 0, sizeof r);
+    r.angle_target = 40, r.angle_tolerance = 1, r.n_rpm = 1, r.n = 3;
+    r.csa_data[0] = 50, r.csa_data_sd[0] = 1;
+    const double mu_s[3] = {0.9, 0.8, 0.95}, mu_r[3] = {0.2, 0.05, 0.2}, angle[3] = {40, 43, 40}, csa[3] = {50, 50, 53};
+    for (int k = 0; k < 3; ++k) {
+        cal_candidate *c = &r.cand[k];
+        c->mu_s = mu_s[k], c->mu_r = mu_r[k], c->angle_deg = angle[k], c->csa[0] = csa[k], c->usable[0] = 1;
+    }
+    cal_friction_identify(&r);
+    assert_true(r.cand[0].identified && !r.cand[1].identified && !r.cand[2].identified); // χ² 0, 9, 9
+    const cal_bounds b = {.mu_s_min = 0.1, .mu_s_max = 1, .mu_r_min = 1e-5, .mu_r_max = 0.5};
+    cal_range_bracket(&r.mu_s_range, b.mu_s_min, b.mu_s_max), cal_range_bracket(&r.mu_r_range, b.mu_r_min, b.mu_r_max);
+    assert_true(r.mu_s_range.bracket_lo == 0.8 && r.mu_s_range.bracket_hi == 0.95); // the test can fail: B brackets
+    assert_true(r.mu_r_range.bracket_lo == 0.05 && r.mu_r_range.bracket_hi == 0.5);
+    cal_range s = cal_friction_range_along(&r, 0, &b), m = cal_friction_range_along(&r, 1, &b);
+    assert_true(s.lo == 0.9 && s.hi == 0.9 && s.bracket_lo == 0.1 && s.bracket_hi == 0.95);
+    assert_true(m.lo == 0.2 && m.hi == 0.2 && m.bracket_lo == 1e-5 && m.bracket_hi == 0.5);
 }
 
 int main(void)
@@ -709,6 +742,7 @@ int main(void)
         cmocka_unit_test(test_unsteady_angle_ranked_at_worst),
         cmocka_unit_test(test_friction_rule),
         cmocka_unit_test(test_identified_ranges),
+        cmocka_unit_test(test_range_along_the_other_friction),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
