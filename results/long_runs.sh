@@ -28,8 +28,8 @@
 # by side use it fully, where a lone run on two threads turns only 1.29-1.47x faster
 # (results/benchmarks/threads_2core/). NICE: a run's share when a test suite or a third run competes.
 # A run is listed here while its README says IN PROGRESS; take it out when it is done (twin-data, the
-# twin's synthesis, ended 2026-12-02: results/twin_standard/README.md). twin-calibration (step 2 there)
-# seeds its store from the rerun's before its first start (the row's last field).
+# twin's synthesis, and twin-calibration, its calibration, both ended 2026-12-02:
+# results/twin_standard/README.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 granucal=${GRANUCAL:-build/granucal}
@@ -39,7 +39,6 @@ granucal=${GRANUCAL:-build/granucal}
 # anything (run each start: it must leave what is already there as it is)
 runs=(
   "rerun|results/calibration-standard-r2|results/calibration-standard-r2/run.log|10|yes|$granucal calibrate configs/calibration.yaml --tier standard --jobs 1 --out results/calibration-standard-r2"
-  "twin-calibration|results/twin_standard|results/twin_standard/calibration/run.log|10|waits|$granucal calibrate configs/calibration.yaml --tier standard --data results/twin_standard/data --jobs 1 --out results/twin_standard/calibration|mkdir -p results/twin_standard/calibration/store && cp -n results/calibration-standard-r2/store/*.yaml results/calibration-standard-r2/store/*.start.h5 results/twin_standard/calibration/store/"
   "stiffness-L512|results/stiffness_drum_L512|results/stiffness_drum_L512/run.log|19|waits|$granucal calibrate configs/calibration.yaml --tier fine-levels --stage stiffness --jobs 1 --out results/stiffness_drum_L512"
 )
 field() { cut -d'|' -f"$2" <<< "$1"; }
