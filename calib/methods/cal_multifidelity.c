@@ -84,9 +84,21 @@ void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, dou
     }
 }
 
+// Whether measurement k's correction has the kriging's variance model.
+static int has_variance(const cal_mf_correction *c, int k) { return c && c->n_runs >= 2 && c->scale[k] > 0; }
+
+const char *cal_mf_correction_unmodelled(const cal_mf_correction *c, int n_y, int kriging)
+{
+    if (!kriging) return "an affine correction";
+    if (!c || c->n_runs < 2) return "one run at this tier (kriging needs two)";
+    for (int k = 0; k < n_y; ++k)
+        if (!has_variance(c, k)) return "a kriging GSL could not factor";
+    return NULL;
+}
+
 double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double v)
 {
-    if (!c || c->n_runs < 2 || !(c->scale[k] > 0)) return 0;
+    if (!has_variance(c, k)) return 0;
     const size_t m = (size_t)c->n_runs;
     gsl_matrix *K = gsl_matrix_alloc(m, m);
     gsl_vector *kx = gsl_vector_alloc(m), *a = gsl_vector_alloc(m);

@@ -95,6 +95,14 @@ void cal_mf_correct(const cal_mf_correction *c, int n_y, double u, double v, dou
 /// variance model.
 double cal_mf_correction_sd(const cal_mf_correction *c, int k, double u, double v);
 
+/// Why the correction carries no variance model for some of its n_y
+/// measurements, NULL when the kriging's covers every one (kriging: 1 for a
+/// kriging correction, 0 for an affine one): "an affine correction", "one run
+/// at this tier (kriging needs two)", or "a kriging GSL could not factor".
+/// Without one, cal_mf_correction_sd is 0 and whatever samples the corrected
+/// map (the posterior) takes the correction as exact.
+const char *cal_mf_correction_unmodelled(const cal_mf_correction *c, int n_y, int kriging);
+
 /// What the stage gives the loop.
 typedef struct cal_mf_problem {
     int n_y;

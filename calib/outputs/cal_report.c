@@ -138,11 +138,11 @@ static const char *value_cell(char out[224], const cal_table_row *r)
         snprintf(out, 224, "%s (the search stopped on its bound %.3g)", text, r->value);
     else if (r->verdict.status == CAL_VALUE_ONE_SIDED)
         snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between %.3g and the bound%s)", text,
-                 r->value, r->verdict.known, cal_verdict_wide_clause(&r->verdict));
+                 r->value, r->verdict.known, cal_verdict_posterior_clause(&r->verdict));
     else if (r->verdict.status == CAL_VALUE_BOUNDED)
         snprintf(out, 224, "%s (the search ended at %.3g; no run excludes a value between these, more than half the "
                            "range%s)", text, r->value,
-                 cal_verdict_wide_clause(&r->verdict));
+                 cal_verdict_posterior_clause(&r->verdict));
     else if (r->verdict.status == CAL_VALUE_NOT_A_RESULT)
         snprintf(out, 224, "%s (the search ended at %.3g, outside its own interval)", text, r->value);
     else snprintf(out, 224, "%s", text);
@@ -624,6 +624,12 @@ static void report_posterior(FILE *f, const cal_friction_result *r, const cal_bo
     for (int k = 0; k < p->n_y; ++k)
         fprintf(f, "| %s | %.3g | %.3g | %.3g | %.3g |\n", p->observable[k], p->data_sd[k], p->map_rms[k],
                 p->kriging_sd[k], p->spread[k]);
+    if (p->correction_unmodelled)
+        fprintf(f, "\n**This posterior takes the correction as exact** (%s): the kriging's sd, the one part of the "
+                   "spread that says how well this tier's runs measured the correction, is absent, so its width "
+                   "counts nothing of that. It decides no status here: each friction's is the runs' intervals' "
+                   "alone (flag credible_correction_exact).\n",
+                p->correction_unmodelled);
     if (cal_posterior_map_bound(p))
         fputs("\n**The map's residual, not the data, sets this posterior's width**: for a measurement that tells a "
               "parameter, the map tier's fit misses its own candidates by more than the data's spread. More runs at "
@@ -778,7 +784,7 @@ static cal_outcome with_credible(const cal_outcome *o, const posteriors *post)
         const cal_posterior *q = &post->of[i];
         for (int k = 0; k < 2; ++k)
             judged.credible[i][k] = (cal_credible){1, q->lo[k], q->hi[k], q->reaches_lower[k], q->reaches_upper[k],
-                                                     q->width[k]};
+                                                     q->width[k], q->correction_unmodelled != NULL};
     }
     return judged;
 }

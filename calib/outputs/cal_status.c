@@ -38,8 +38,10 @@ static const char *open_flag(int side) { return side > 0 ? "not_excluded_to_uppe
 // A value on a bound, relative to the bound's size (μr's bounds span decades).
 static int on_bound(double value, double bound) { return fabs(value - bound) <= 1e-9 * fabs(bound); }
 
-const char *cal_verdict_wide_clause(const cal_verdict *v)
+const char *cal_verdict_posterior_clause(const cal_verdict *v)
 {
+    if (cal_verdict_has_flag(v, "credible_correction_exact"))
+        return "; its posterior takes a correction with no variance model as exact, and decides nothing";
     return cal_verdict_has_flag(v, "credible_wide") ? "; its posterior spans more than half the search range" : "";
 }
 
@@ -111,6 +113,13 @@ cal_verdict cal_verdict_friction(double value, cal_range g, const cal_bounds *b,
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c)
 {
     if (!c || !c->known || v->status == CAL_VALUE_NOT_RUN) return;
+    if (c->correction_exact) {
+        // A correction measured at one run (or fitted as a plane) has no variance model: the posterior's
+        // width then counts nothing of how well this tier's runs measured it, so it neither closes nor
+        // narrows what the runs leave, nor throws out what they keep. The runs' intervals decide alone.
+        add_flag(v, "credible_correction_exact");
+        return;
+    }
     // Beyond an end that runs to its search bound, the value lies between that end and the bound: the
     // posterior does not hold it off (its 2.5 % and 97.5 % points sit inside the bounds by construction).
     int beyond_open_end = (value > c->hi && c->reaches_upper) || (value < c->lo && c->reaches_lower);
@@ -275,15 +284,15 @@ void cal_table_caveats(FILE *f, const cal_outcome *o, const char *prefix)
         if (st == CAL_VALUE_INPUT || st == CAL_VALUE_DERIVED || st == CAL_VALUE_CALIBRATED) continue;
         fprintf(f, "%s%s %s%s%s = %.6g: %s", prefix, r->contact, r->material, r->material[0] ? " " : "", r->parameter,
                 r->value, cal_value_status_name(st));
-        const char *wide = cal_verdict_wide_clause(&r->verdict);
+        const char *clause = cal_verdict_posterior_clause(&r->verdict);
         if (st == CAL_VALUE_ONE_SIDED)
             fprintf(f, ", only %s %.6g is known (%s%s)", r->verdict.side > 0 ? ">=" : "<=", r->verdict.known,
                     r->verdict.on_bound ? "the search stopped on its bound"
                                         : "no run excludes a value from there to the search's bound",
-                    wide);
+                    clause);
         if (st == CAL_VALUE_BOUNDED)
             fprintf(f, ", only %.6g - %.6g is known (the runs exclude both sides, leaving more than half the search "
-                       "range%s)", r->verdict.between[0], r->verdict.between[1], wide);
+                       "range%s)", r->verdict.between[0], r->verdict.between[1], clause);
         fprintf(f, " (%s)\n", r->verdict.flags);
     }
 }

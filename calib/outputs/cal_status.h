@@ -44,7 +44,8 @@ typedef struct cal_verdict {
                       ///< not_excluded_to_upper_bound (the value off the bound, the interval no run excludes
                       ///< running to it), outside_identified, outside_not_excluded, outside_credible,
                       ///< not_excluded_wide (the runs close both sides but leave more than
-                      ///< CAL_CALIBRATED_MAX_WIDTH of the range), credible_wide (a posterior held off the
+                      ///< CAL_CALIBRATED_MAX_WIDTH of the range), credible_correction_exact (the posterior
+                      ///< takes a correction with no variance model as exact: it decided nothing), credible_wide (a posterior held off the
                       ///< bound the runs leave open, or within their wide interval, spanning more than that),
                       ///< not_identified, angle_not_matched, stage_not_run, stiffness_at_cylinder_lambda (stage 1
                       ///< swept a cylinder at another λ than the drum's)
@@ -77,14 +78,21 @@ cal_verdict cal_verdict_friction(double value, cal_range g, const cal_bounds *b,
 /// runs leaves open. Held off but wider, the value stays one-sided (flag
 /// credible_wide). A bounded value is calibrated where its posterior spans at
 /// most CAL_CALIBRATED_MAX_WIDTH (and holds it); wider, it stays bounded.
+/// A posterior that takes its correction as exact (c->correction_exact: the
+/// correction measured at one run of the deciding tier, or fitted as a
+/// plane, has no variance model) decides nothing: the value keeps the
+/// status its runs gave it, flagged credible_correction_exact.
 void cal_verdict_credible(cal_verdict *v, double value, const cal_credible *c);
 
 /// Whether the verdict carries that flag.
 int cal_verdict_has_flag(const cal_verdict *v, const char *flag);
 
-/// The clause the outputs append to a value flagged credible_wide ("; its
-/// posterior spans more than half the search range"), "" otherwise.
-const char *cal_verdict_wide_clause(const cal_verdict *v);
+/// The clause the outputs append to a one-sided or bounded value whose
+/// posterior did not decide it: flagged credible_correction_exact ("; its
+/// posterior takes a correction with no variance model as exact, and decides
+/// nothing") or credible_wide ("; its posterior spans more than half the
+/// search range"); "" otherwise.
+const char *cal_verdict_posterior_clause(const cal_verdict *v);
 
 /// The status's name as the CSV writes it: "calibrated", "one-sided", ...
 const char *cal_value_status_name(cal_value_status s);

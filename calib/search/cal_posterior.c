@@ -72,6 +72,8 @@ static int build_model(const cal_friction_result *r, const cal_bounds *b, model 
     m->r = r;
     if (r->has_map) {
         m->map = r->cheap_map, m->correction = &r->discrepancy;
+        out->correction_unmodelled = cal_mf_correction_unmodelled(
+            m->correction, m->map.n_y, r->map_correction && strcmp(r->map_correction, "kriging") == 0);
         out->model = r->n_levels > 1 ? "the corrected map of the multilevel search (the quadratic map through the "
                                        "map tier's runs and predictions, each weighed by its spread, plus the "
                                        "discrepancy measured at this tier's runs)"

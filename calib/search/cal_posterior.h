@@ -51,6 +51,13 @@ typedef struct cal_posterior {
     /// for a one-tier map); spread: the three in quadrature there, as the
     /// likelihood counts them.
     double map_rms[CAL_MF_MAX_Y], kriging_sd[CAL_MF_MAX_Y], spread[CAL_MF_MAX_Y];
+    /// NULL, or why the corrected map's correction has no variance model
+    /// (cal_mf_correction_unmodelled: one run at this tier, an affine
+    /// correction): then the posterior takes the correction as exact, its
+    /// width counts nothing of how well this tier's runs measured it, and it
+    /// decides no value's status (cal_verdict_credible). NULL for a one-tier
+    /// map (no correction).
+    const char *correction_unmodelled;
 } cal_posterior;
 
 /// Whether the map's residual, not the data's spread, is the larger part of

@@ -246,11 +246,11 @@ static int posterior_next(const cal_mf_correction *c, double *u, double *v, void
     r->posterior_share = need.share;
     snprintf(r->posterior_share_of, sizeof r->posterior_share_of, "%s",
              need.measurement >= 0 ? post.observable[need.measurement] : "no measurement the data can tell");
-    int kriging = r->map_correction && strcmp(r->map_correction, "kriging") == 0;
-    if (none && (!kriging || c->n_runs < 2))
+    const char *unmodelled = post.correction_unmodelled;
+    if (none && unmodelled)
         fprintf(stderr, "-- posterior: %s: the correction has no variance model, so no share of the map's uncertainty "
                         "to judge by; no more runs\n",
-                kriging ? "one run at this tier (kriging needs two)" : "an affine correction");
+                unmodelled);
     else if (none && need.measurement < 0)
         fprintf(stderr, "-- posterior: no measurement moves by one data spread with a parameter the data can tell: "
                         "no run would narrow it; no more runs\n");

@@ -96,6 +96,10 @@ typedef struct cal_credible {
     double lo, hi;
     int reaches_lower, reaches_upper; ///< the interval runs to that search bound
     double width;                     ///< as a fraction of the search range, on the search's scale
+    /// 1: the posterior takes its corrected map's correction as exact (no
+    /// variance model: cal_posterior.correction_unmodelled), so it decides
+    /// no status
+    int correction_exact;
 } cal_credible;
 
 /// One tier below a two-tier stage's own (its map tier, or a level further

@@ -9,7 +9,8 @@
 #   one outside its credible interval unless beyond an end that runs to within 3 % of the search range
 #   (μs linear, μr in log10) of its bound; a posterior closes a side the runs leave open only where it is
 #   held off that bound and spans at most half the search range; runs that close both sides but leave
-#   more than half the range, with no posterior narrower than that, make it 'bounded';
+#   more than half the range, with no posterior narrower than that, make it 'bounded'; a posterior
+#   flagged credible_correction_exact (its correction has no variance model) decides none of this;
 # - calibrated_parameters.md, report.md, liggghts_parameters.in, lammps_parameters.in: the banner
 #   (DEMONSTRATION or CALIBRATION, the tier, the data's provenance); the two .in files list every
 #   friction the data did not choose (and the stiffness where stage 1 did not choose it) on a
@@ -48,9 +49,16 @@ def range_fraction(parameter, lo, hi, lo_bound, hi_bound):
     return (unit(hi) - unit(lo)) / (unit(hi_bound) - unit(lo_bound))
 
 
+def posterior_decides(r):
+    """A posterior decides a status where there is one and it does not take its correction as exact
+    (flag credible_correction_exact: a correction measured at one run, or fitted as a plane, has no
+    variance model, so the posterior's width says nothing of how well the runs measured it)."""
+    return r.get('credible_min', '') != '' and 'credible_correction_exact' not in r['flags'].split(';')
+
+
 def outside_credible(r, v, lo_bound, hi_bound, outside):
     """Outside the posterior's 95 % credible interval, and not beyond an end that reaches its bound."""
-    if r.get('credible_min', '') == '':
+    if not posterior_decides(r):
         return False
     clo, chi = float(r['credible_min']), float(r['credible_max'])
     reaches_lower, reaches_upper = reaches_bounds(r['parameter'], clo, chi, lo_bound, hi_bound)
@@ -78,7 +86,7 @@ def expected_status(r, lo_bound, hi_bound):
     # posterior is held off that bound (it closes the side the runs' cut leaves open).
     open_lo, open_hi = near(blo, lo_bound), near(bhi, hi_bound)
     if open_lo or open_hi:
-        if r.get('credible_min', '') == '':
+        if not posterior_decides(r):
             return 'one-sided'
         clo, chi = float(r['credible_min']), float(r['credible_max'])
         reaches_lower, reaches_upper = reaches_bounds(r['parameter'], clo, chi, lo_bound, hi_bound)
@@ -89,7 +97,7 @@ def expected_status(r, lo_bound, hi_bound):
         return 'calibrated'
     # Closed on both sides by the runs: calibrated where they, or a posterior, leave at most half the range.
     if range_fraction(r['parameter'], blo, bhi, lo_bound, hi_bound) > 0.5 + 1e-6:
-        if r.get('credible_min', '') == '' or range_fraction(r['parameter'], float(r['credible_min']),
+        if not posterior_decides(r) or range_fraction(r['parameter'], float(r['credible_min']),
                                                               float(r['credible_max']), lo_bound, hi_bound) > 0.5 + 1e-6:
             return 'bounded'
     return 'calibrated'

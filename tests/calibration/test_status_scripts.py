@@ -39,6 +39,17 @@ class ExpectedStatus(unittest.TestCase):
         self.assertEqual(says.expected_status(row('mu_s', 0.569, (0.102, 1.0), (0.30, 0.93)), 0.1, 1.0), 'one-sided')
         self.assertEqual(says.expected_status(row('mu_s', 0.569, (0.102, 1.0), (0.40, 0.85)), 0.1, 1.0), 'calibrated')
 
+    def test_a_posterior_taking_its_correction_as_exact_decides_nothing(self):
+        # The standard twin's PP μs: the same narrow posterior closes the open side only with a variance
+        # model behind its correction; without one the runs' interval decides alone.
+        exact = 'not_excluded_to_upper_bound;credible_correction_exact'
+        self.assertEqual(says.expected_status(row('mu_s', 0.4435, (0.325, 1.0), (0.378, 0.565)), 0.1, 1.0),
+                         'calibrated')
+        self.assertEqual(says.expected_status(row('mu_s', 0.4435, (0.325, 1.0), (0.378, 0.565), exact), 0.1, 1.0),
+                         'one-sided')
+        self.assertEqual(says.expected_status(row('mu_s', 0.7, (0.5, 0.9), (0.1, 0.3), 'credible_correction_exact'),
+                                              0.1, 1.0), 'calibrated')
+
     def test_outside_a_narrow_posterior_is_not_a_result(self):
         self.assertEqual(says.expected_status(row('mu_s', 0.9, (0.1016, 0.95), (0.40, 0.76)), 0.1, 1.0),
                          'not a result')

@@ -462,6 +462,10 @@ static void a_run_not_steady_counts_by_its_own_spread(void **state)
         cal_mf_correct(&r.correction, N_Y, 0.2, 0.5, at_a), cal_mf_correct(&r.correction, N_Y, 0.8, 0.5, at_b);
         printf("%s: correction %.4f at the steady run, %.4f at the unsteady one (plane mean %.4f)\n",
                kind ? "affine" : "kriging", at_a[0], at_b[0], r.correction.at[0]);
+        // Two runs: the kriging has its variance model; a plane never has one.
+        const char *unmodelled = cal_mf_correction_unmodelled(&r.correction, N_Y, !kind);
+        if (kind) assert_string_equal(unmodelled, "an affine correction");
+        else assert_null(unmodelled);
         for (int k = 0; k < N_Y; ++k) {
             assert_float_equal(r.correction.at[k], weighted, 1e-9);
             if (kind) continue;
@@ -472,10 +476,28 @@ static void a_run_not_steady_counts_by_its_own_spread(void **state)
     }
 }
 
+// A correction measured at one run is a single difference: no variance
+// model, which the posterior must know (it then takes the correction as exact).
+static void one_run_leaves_the_correction_without_a_variance_model(void **state)
+{
+    (void)state;
+    cal_mf_correction one = {0};
+    one.at[0] = -0.15; // the plane alone, its mean: kriging needs two runs
+    assert_string_equal(cal_mf_correction_unmodelled(&one, N_Y, 1), "one run at this tier (kriging needs two)");
+    assert_float_equal(cal_mf_correction_sd(&one, 0, 0.5, 0.5), 0, 0);
+    cal_mf_correction two = {0};
+    two.n_runs = 2;
+    for (int k = 0; k < N_Y; ++k) two.scale[k] = 1;
+    assert_null(cal_mf_correction_unmodelled(&two, N_Y, 1));
+    two.scale[N_Y - 1] = 0; // GSL could not factor that measurement's system
+    assert_string_equal(cal_mf_correction_unmodelled(&two, N_Y, 1), "a kriging GSL could not factor");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_quadratic_is_fitted_exactly),
+        cmocka_unit_test(one_run_leaves_the_correction_without_a_variance_model),
         cmocka_unit_test(too_few_points_are_refused),
         cmocka_unit_test(a_weighted_fit_trusts_each_point_by_its_spread),
         cmocka_unit_test(a_constant_bias_is_measured_and_removed),

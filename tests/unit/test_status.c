@@ -48,14 +48,14 @@ static void test_an_interval_open_to_a_bound_is_one_sided(void **state)
     assert_string_equal(v.flags, "not_excluded_to_upper_bound");
     assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.775, &v), "≥ 0.325");
     // Its posterior runs to the same bound (0.585 - 0.993): still one-sided.
-    cal_credible to_upper = {1, 0.585, 0.993, 0, 1, 0.453};
+    cal_credible to_upper = {1, 0.585, 0.993, 0, 1, 0.453, 0};
     cal_verdict_credible(&v, 0.775, &to_upper);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     // A posterior held off that bound closes the side: calibrated, the open interval's flag gone.
     // (The standard run's granule μr: 0.1918, not excluded 0.106 - 0.5, credible 0.098 - 0.33.)
     v = cal_verdict_friction(0.191835, range(0.191835, 0.191835, 0.105737, 0.5), &granule_box, 1, 1);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
-    cal_credible held_off = {1, 0.0983423, 0.329743, 0, 0, 0.195};
+    cal_credible held_off = {1, 0.0983423, 0.329743, 0, 0, 0.195, 0};
     cal_verdict_credible(&v, 0.191835, &held_off);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
     assert_int_equal(v.side, 0);
@@ -127,14 +127,14 @@ static void test_outside_its_credible_interval_is_not_a_result(void **state)
     // outside its 95 % credible interval 1.2e-5 - 0.02: not a result, whatever the runs' cut says.
     cal_verdict v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), &box, 1, 1);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED); // by the runs' cut alone: open to the upper bound
-    cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0, 0.686};
+    cal_credible narrow = {1, 1.2e-5, 0.02, 1, 0, 0.686, 0};
     cal_verdict_credible(&v, 0.0334, &narrow);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_string_equal(v.flags, "outside_credible");
     // Inside a posterior held off the upper bound (1e-3 - 0.2, 0.49 of the log range: calibrated), then
     // with no posterior (a stage read from a stage file), nothing changes.
     v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), &box, 1, 1);
-    cal_credible held_off_narrow = {1, 1e-3, 0.2, 0, 0, 0.490}, none = {0};
+    cal_credible held_off_narrow = {1, 1e-3, 0.2, 0, 0, 0.490, 0}, none = {0};
     cal_verdict_credible(&v, 0.0334, &held_off_narrow);
     cal_verdict_credible(&v, 0.0334, &none);
     cal_verdict_credible(&v, 0.0334, NULL);
@@ -143,16 +143,47 @@ static void test_outside_its_credible_interval_is_not_a_result(void **state)
     // The standard run's granule μs on its upper bound 1.0, credible 0.663 - 0.996 running to that bound: the
     // 97.5 % point of a posterior sits below the bound by construction, so it stays one-sided.
     v = cal_verdict_friction(1.0, range(1.0, 1.0, 0.775, 1.0), &box, 0, 1);
-    cal_credible to_upper = {1, 0.662998, 0.995937, 0, 1, 0.370};
+    cal_credible to_upper = {1, 0.662998, 0.995937, 0, 1, 0.370, 0};
     cal_verdict_credible(&v, 1.0, &to_upper);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     assert_string_equal(v.flags, "at_upper_bound");
     // The same bound with a posterior held off it (credible 0.3 - 0.7): the data say the bound is wrong.
-    cal_credible held_off = {1, 0.3, 0.7, 0, 0, 0.444};
+    cal_credible held_off = {1, 0.3, 0.7, 0, 0, 0.444, 0};
     cal_verdict_credible(&v, 1.0, &held_off);
     assert_int_equal(v.status, CAL_VALUE_NOT_A_RESULT);
     assert_int_equal(v.side, 0);
     assert_string_equal(v.flags, "at_upper_bound;outside_credible");
+}
+
+static void test_a_posterior_taking_its_correction_as_exact_decides_nothing(void **state)
+{
+    (void)state;
+    char text[48];
+    // The standard twin's PP μs: one λ 1000 run at 0.4435, the runs' interval 0.4435 - 1 (not excluded
+    // 0.325 - 1) open to the bound; a posterior 0.378 - 0.565, held off 1 and spanning 0.21 of the range,
+    // closed that side and called 0.4435 calibrated (the truth was 0.9). With one run the correction has
+    // no variance model, so that width counts nothing of how well it was measured: only μs ≥ 0.325 is known.
+    cal_credible one_run = {1, 0.378, 0.565, 0, 0, (0.565 - 0.378) / 0.9, 1};
+    cal_verdict v = cal_verdict_friction(0.4435, range(0.4435, 1.0, 0.325, 1.0), &box, 0, 1);
+    cal_verdict_credible(&v, 0.4435, &one_run);
+    assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
+    assert_int_equal(v.side, +1);
+    assert_float_equal(v.known, 0.325, 1e-12);
+    assert_string_equal(v.flags, "not_excluded_to_upper_bound;credible_correction_exact");
+    assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.4435, &v), "≥ 0.325");
+    assert_string_equal(cal_verdict_posterior_clause(&v),
+                        "; its posterior takes a correction with no variance model as exact, and decides nothing");
+    // The same posterior with a variance model behind it closes the side, as the rule says.
+    cal_credible modelled = one_run;
+    modelled.correction_exact = 0;
+    v = cal_verdict_friction(0.4435, range(0.4435, 1.0, 0.325, 1.0), &box, 0, 1);
+    cal_verdict_credible(&v, 0.4435, &modelled);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    // Nor does it throw out what the runs keep: a value the runs call calibrated, outside that posterior.
+    v = cal_verdict_friction(0.7, range(0.6, 0.8, 0.5, 0.9), &box, 0, 1);
+    cal_verdict_credible(&v, 0.7, &one_run);
+    assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
+    assert_string_equal(v.flags, "credible_correction_exact");
 }
 
 static void test_a_wide_posterior_does_not_close_a_side(void **state)
@@ -163,7 +194,7 @@ static void test_a_wide_posterior_does_not_close_a_side(void **state)
     // bound 1 (of 0.1 - 1). A posterior 0.30 - 0.93 is held off 1, but spans 0.70 of the range: it does not
     // close that side; only μs ≥ 0.102 is known.
     cal_verdict v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), &box, 0, 1);
-    cal_credible wide = {1, 0.30, 0.93, 0, 0, (0.93 - 0.30) / 0.9};
+    cal_credible wide = {1, 0.30, 0.93, 0, 0, (0.93 - 0.30) / 0.9, 0};
     cal_verdict_credible(&v, 0.569, &wide);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     assert_int_equal(v.side, +1);
@@ -175,13 +206,13 @@ static void test_a_wide_posterior_does_not_close_a_side(void **state)
     assert_false(cal_verdict_has_flag(&v, "wide"));
     // The same in log μr: 1.2e-5 - 0.2 held off 0.5 spans 0.90 of the decades 1e-5 - 0.5.
     v = cal_verdict_friction(0.0334, range(0.0334, 0.0334, 1.5e-4, 0.5), &box, 1, 1);
-    cal_credible wide_log = {1, 1.2e-5, 0.2, 1, 0, 0.898};
+    cal_credible wide_log = {1, 1.2e-5, 0.2, 1, 0, 0.898, 0};
     cal_verdict_credible(&v, 0.0334, &wide_log);
     assert_int_equal(v.status, CAL_VALUE_ONE_SIDED);
     assert_string_equal(v.flags, "not_excluded_to_upper_bound;credible_wide");
     // At the rule's edge: half the range closes the side, a hair more does not.
     v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), &box, 0, 1);
-    cal_credible half = {1, 0.40, 0.85, 0, 0, CAL_CALIBRATED_MAX_WIDTH};
+    cal_credible half = {1, 0.40, 0.85, 0, 0, CAL_CALIBRATED_MAX_WIDTH, 0};
     cal_verdict_credible(&v, 0.569, &half);
     assert_int_equal(v.status, CAL_VALUE_CALIBRATED);
     v = cal_verdict_friction(0.569, range(0.569, 0.569, 0.102, 1.0), &box, 0, 1);
@@ -206,7 +237,7 @@ static void test_runs_that_leave_most_of_the_range_bound_it(void **state)
     assert_string_equal(cal_verdict_value_text(text, sizeof text, 0.569, &v), "0.102 – 0.95");
     assert_string_equal(cal_value_status_name(v.status), "bounded");
     // A posterior that spans 0.70 of the range leaves it bounded; one of 0.40 holding the value pins it.
-    cal_credible wide = {1, 0.25, 0.88, 0, 0, 0.70}, narrow = {1, 0.40, 0.76, 0, 0, 0.40};
+    cal_credible wide = {1, 0.25, 0.88, 0, 0, 0.70, 0}, narrow = {1, 0.40, 0.76, 0, 0, 0.40, 0};
     cal_verdict_credible(&v, 0.569, &wide);
     assert_int_equal(v.status, CAL_VALUE_BOUNDED);
     assert_string_equal(v.flags, "not_excluded_wide;credible_wide");
@@ -249,6 +280,7 @@ int main(void)
         cmocka_unit_test(test_nothing_excluded_is_not_identified),
         cmocka_unit_test(test_outside_its_credible_interval_is_not_a_result),
         cmocka_unit_test(test_a_wide_posterior_does_not_close_a_side),
+        cmocka_unit_test(test_a_posterior_taking_its_correction_as_exact_decides_nothing),
         cmocka_unit_test(test_runs_that_leave_most_of_the_range_bound_it),
         cmocka_unit_test(test_a_stage_not_run_is_not_calibrated),
     };
